@@ -1,0 +1,157 @@
+//! `hooke run`, `hooke check` and `hooke convert`.
+
+use crate::source;
+use crate::trajectory::TrajectoryWriter;
+use crate::{RunArgs, SetupArgs};
+use anyhow::{Context, Result, bail};
+use hooke_core::{Divergence, Integrator, Simulation, StabilityEstimate, Summary};
+use hooke_scene::Scene;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::Path;
+use std::process::ExitCode;
+
+/// Steps `scene` to its end, calling `on_frame(frame, simulation)` at frame 0 and after every
+/// `every` steps. A divergence comes back as an error holding a [`Divergence`].
+pub fn drive(scene: &mut Scene, mut on_frame: impl FnMut(u64, &Simulation) -> Result<()>) -> Result<()> {
+    let (steps, every) = (scene.steps, scene.every);
+    let progress = if std::io::stderr().is_terminal() && steps >= 10_000 {
+        let bar = ProgressBar::new(steps);
+        bar.set_style(
+            ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} steps, {elapsed} elapsed, eta {eta}")
+                .expect("valid template")
+                .progress_chars("=> "),
+        );
+        bar.set_prefix(scene.spec.name.clone());
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let sim = &mut scene.simulation;
+    on_frame(0, sim)?;
+    for frame in 1..=steps / every {
+        sim.advance(every)?;
+        on_frame(frame, sim)?;
+        progress.set_position(sim.steps());
+    }
+    // Steps past the last full frame are still run: the run's length is what was asked for.
+    sim.advance(steps % every)?;
+    progress.finish_and_clear();
+    Ok(())
+}
+
+fn is_divergence(e: &anyhow::Error) -> bool {
+    e.downcast_ref::<Divergence>().is_some()
+}
+
+/// Warns on stderr when the scene's step exceeds the estimated stable step.
+fn warn_if_unstable(scene: &Scene) -> StabilityEstimate {
+    let sim = &scene.simulation;
+    let estimate = sim.stability();
+    let limit = estimate.max_dt(sim.integrator());
+    if sim.dt() > limit {
+        eprintln!(
+            "warning: dt = {} s exceeds the estimated stable step of {} ({limit:.3e} s, ω_max = {:.4e} rad/s); the run may diverge",
+            sim.dt(),
+            sim.integrator(),
+            estimate.omega_max
+        );
+    }
+    estimate
+}
+
+pub fn run(args: &RunArgs) -> Result<ExitCode> {
+    let mut scene = source::build(&args.scene, &args.setup.overrides())?;
+    warn_if_unstable(&scene);
+    let mut trajectory = args.trajectory.as_deref().map(TrajectoryWriter::create).transpose()?;
+    let every = scene.every;
+    let dt = scene.simulation.dt();
+    if args.summary {
+        println!(
+            "{:>6} {:>10} {:>13} {:>13} {:>26} {:>26} {:>10} {:>11}",
+            "frame", "time", "kinetic", "potential", "bbox min", "bbox max", "max speed", "max depth"
+        );
+    }
+    let result = drive(&mut scene, |frame, sim| {
+        // SPEC §6: the time of frame f is (f K) dt computed as one product.
+        let time = (frame * every) as f64 * dt;
+        if let Some(t) = trajectory.as_mut() {
+            t.frame(frame, time, sim.particles())?;
+        }
+        if args.summary {
+            let s = Summary::of(sim.model(), sim.particles());
+            let v = |v: hooke_core::Vec3| format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z);
+            println!(
+                "{frame:>6} {time:>10.4} {:>13.6e} {:>13.6e} {:>26} {:>26} {:>10.4} {:>11.3e}",
+                s.kinetic,
+                s.potential,
+                v(s.min),
+                v(s.max),
+                s.max_speed,
+                s.max_penetration
+            );
+        }
+        Ok(())
+    });
+    // After a divergence the frames already written are complete and are kept.
+    if result.is_ok() || result.as_ref().is_err_and(is_divergence) {
+        if let Some(t) = trajectory {
+            t.finish()?;
+        }
+    }
+    result?;
+    let sim = &scene.simulation;
+    eprintln!(
+        "{}: {} steps of {} s with {} ({} s simulated), {} particles, {} springs",
+        scene.spec.name,
+        sim.steps(),
+        sim.dt(),
+        sim.integrator(),
+        sim.time(),
+        sim.particles().len(),
+        sim.model().springs.len()
+    );
+    if let Some(path) = &args.trajectory {
+        eprintln!("trajectory: {} ({} frames)", path.display(), scene.steps / every + 1);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
+    let scene = source::build(arg, &setup.overrides())?;
+    let sim = &scene.simulation;
+    let estimate = warn_if_unstable(&scene);
+    println!("scene {}: {} particles, {} springs", scene.spec.name, sim.particles().len(), sim.model().springs.len());
+    println!("highest angular frequency ω_max ≈ {:.4e} rad/s (power iteration on M⁻¹K)", estimate.omega_max);
+    println!("scene step: dt = {} s with {}", sim.dt(), sim.integrator());
+    for integrator in Integrator::ALL {
+        let limit = estimate.max_dt(integrator);
+        let mark = if integrator == sim.integrator() { "  <- scene" } else { "" };
+        let note = match integrator {
+            Integrator::Euler | Integrator::Midpoint => " (needs damping: amplifies undamped oscillation at any dt)",
+            _ => "",
+        };
+        println!("  {:<11} stable for dt < {limit:.3e} s{note}{mark}", integrator.name());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+pub fn convert(input: &Path, output: &Path) -> Result<ExitCode> {
+    let ext = |p: &Path| p.extension().and_then(|e| e.to_str()).unwrap_or("").to_string();
+    let text = match (ext(input).as_str(), ext(output).as_str()) {
+        ("w", "toml") => {
+            let world = hooke_scene::world::load_world(input)?;
+            let name = input.file_stem().map_or("world".into(), |s| s.to_string_lossy().into_owned());
+            hooke_scene::to_toml(&world.to_scene(&name))
+        }
+        ("toml", "w") => {
+            let spec = hooke_scene::load_scene(input)?;
+            let world = hooke_scene::world::World::from_scene(&spec).with_context(|| format!("{} cannot be saved as a jello world", input.display()))?;
+            world.to_text()
+        }
+        (a, b) => bail!("cannot convert .{a} to .{b}: expected a .w world and a .toml scene, one each way"),
+    };
+    crate::output::write_atomic(output, text.as_bytes())?;
+    eprintln!("wrote {}", output.display());
+    Ok(ExitCode::SUCCESS)
+}

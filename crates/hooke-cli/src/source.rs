@@ -1,0 +1,45 @@
+//! Turning a SCENE argument (built-in name, `.toml` scene or `.w` world) into a scene.
+
+use anyhow::{Context, Result, bail};
+use hooke_scene::builtin::BUILTINS;
+use hooke_scene::{Overrides, Scene, SceneSpec};
+use std::path::{Path, PathBuf};
+
+/// Where a scene came from.
+pub struct Source {
+    /// The description.
+    pub spec: SceneSpec,
+    /// Folder that relative paths inside it are resolved against.
+    pub base: PathBuf,
+}
+
+/// Reads the scene named by `arg`.
+pub fn read(arg: &str) -> Result<Source> {
+    let path = Path::new(arg);
+    let is_file = path.extension().is_some_and(|e| e == "toml" || e == "w") || path.is_file();
+    if !is_file {
+        let spec = hooke_scene::builtin::builtin(arg).with_context(|| {
+            let names: Vec<&str> = BUILTINS.iter().map(|b| b.0).collect();
+            format!("no built-in scene '{arg}' and no such file; built-in scenes: {}", names.join(", "))
+        })?;
+        return Ok(Source { spec, base: PathBuf::from(".") });
+    }
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let spec = match path.extension().and_then(|e| e.to_str()) {
+        Some("w") => hooke_scene::world::load_world(path)?.to_scene(&stem(path)),
+        Some("toml") => hooke_scene::load_scene(path)?,
+        _ => bail!("{}: expected a scene file ending in .toml or a jello world ending in .w", path.display()),
+    };
+    Ok(Source { spec, base })
+}
+
+fn stem(path: &Path) -> String {
+    path.file_stem().map_or_else(|| "world".into(), |s| s.to_string_lossy().into_owned())
+}
+
+/// Reads and builds the scene named by `arg` with command-line overrides.
+pub fn build(arg: &str, overrides: &Overrides) -> Result<Scene> {
+    let mut source = read(arg)?;
+    overrides.apply(&mut source.spec).with_context(|| format!("scene '{arg}'"))?;
+    source.spec.build(&source.base).with_context(|| format!("scene '{arg}'"))
+}

@@ -1,0 +1,42 @@
+//! Trajectory CSV (SPEC §6): `frame,time,particle,x,y,z,vx,vy,vz`, numbers in Rust's
+//! shortest round-trip form.
+
+use crate::output::AtomicFile;
+use anyhow::{Context, Result};
+use hooke_core::Particles;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The CSV header line.
+pub const HEADER: &str = "frame,time,particle,x,y,z,vx,vy,vz";
+
+/// A trajectory file being written frame by frame.
+pub struct TrajectoryWriter {
+    file: AtomicFile,
+    path: PathBuf,
+}
+
+impl TrajectoryWriter {
+    /// Starts a trajectory file (in place only when finished).
+    pub fn create(path: &Path) -> Result<Self> {
+        let mut file = AtomicFile::create(path)?;
+        writeln!(file.writer(), "{HEADER}").with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(Self { file, path: path.to_path_buf() })
+    }
+
+    /// Appends one frame.
+    pub fn frame(&mut self, frame: u64, time: f64, p: &Particles) -> Result<()> {
+        let w = self.file.writer();
+        for (i, (x, v)) in p.x.iter().zip(&p.v).enumerate() {
+            writeln!(w, "{frame},{time},{i},{},{},{},{},{},{}", x.x, x.y, x.z, v.x, v.y, v.z)
+                .with_context(|| format!("cannot write {}", self.path.display()))?;
+        }
+        Ok(())
+    }
+
+    /// Puts the file in place. Called after the last frame, and after a divergence too: the
+    /// frames written before it are complete and stay.
+    pub fn finish(self) -> Result<()> {
+        self.file.commit()
+    }
+}

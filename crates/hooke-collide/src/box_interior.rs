@@ -1,0 +1,54 @@
+//! The inside of an axis-aligned box as the free space: the jello course's bounding box.
+
+use hooke_core::{Collider, Contact, Vec3};
+
+/// Particles must stay inside `[min, max]`; every coordinate strictly beyond a face is a
+/// violation of that face, with the excess as depth and the normal pointing into the box.
+/// A corner violates up to three faces at once and reports each (SPEC §1: each violated face
+/// adds its own penalty term).
+///
+/// ```
+/// use hooke_collide::BoxInterior;
+/// use hooke_core::{Collider, Vec3};
+/// let room = BoxInterior::jello();
+/// let mut faces = 0;
+/// room.contacts(&Vec3::new(2.5, -2.25, 0.0), &mut |_| faces += 1);
+/// assert_eq!(faces, 2);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoxInterior {
+    /// Lower corner, metres.
+    pub min: Vec3,
+    /// Upper corner, metres.
+    pub max: Vec3,
+}
+
+impl BoxInterior {
+    /// The jello course's box `[-2, 2]^3`.
+    pub fn jello() -> Self {
+        Self { min: Vec3::repeat(-2.0), max: Vec3::repeat(2.0) }
+    }
+}
+
+impl Collider for BoxInterior {
+    fn name(&self) -> String {
+        "box".to_string()
+    }
+
+    fn contacts(&self, p: &Vec3, sink: &mut dyn FnMut(Contact)) {
+        for axis in 0..3 {
+            let mut normal = Vec3::zeros();
+            if p[axis] < self.min[axis] {
+                normal[axis] = 1.0;
+                let mut point = *p;
+                point[axis] = self.min[axis];
+                sink(Contact { depth: self.min[axis] - p[axis], normal, point });
+            } else if p[axis] > self.max[axis] {
+                normal[axis] = -1.0;
+                let mut point = *p;
+                point[axis] = self.max[axis];
+                sink(Contact { depth: p[axis] - self.max[axis], normal, point });
+            }
+        }
+    }
+}

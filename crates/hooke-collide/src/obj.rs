@@ -1,0 +1,144 @@
+//! Reading triangle meshes from Wavefront OBJ text with `tobj`, and placing them in the world.
+
+use hooke_core::Vec3;
+use nalgebra::Rotation3;
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+
+/// One object (`o` or `g` group) of an OBJ file, triangulated, in world coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshPart {
+    /// The object's name in the file (may be empty).
+    pub name: String,
+    /// Vertex positions, metres.
+    pub vertices: Vec<Vec3>,
+    /// Triangles as vertex indices, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Where a mesh sits in the world: `p_world = R (S p) + t`.
+///
+/// `rotate` holds Euler angles in degrees about x, then y, then z (applied in that order).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    /// Translation `t`, metres.
+    pub translate: Vec3,
+    /// Rotation about x, y, z in degrees.
+    pub rotate: Vec3,
+    /// Per-axis scale `S`.
+    pub scale: Vec3,
+}
+
+impl Default for Placement {
+    fn default() -> Self {
+        Self { translate: Vec3::zeros(), rotate: Vec3::zeros(), scale: Vec3::repeat(1.0) }
+    }
+}
+
+impl Placement {
+    /// Maps a point from the mesh's frame to the world.
+    pub fn apply(&self, p: &Vec3) -> Vec3 {
+        let r = self.rotate.map(f64::to_radians);
+        let rotation = Rotation3::from_euler_angles(r.x, r.y, r.z);
+        rotation * p.component_mul(&self.scale) + self.translate
+    }
+}
+
+/// Why a mesh could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    /// The file could not be read.
+    #[error("cannot read mesh {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// tobj refused the text.
+    #[error("{path}: not a valid OBJ mesh: {reason}")]
+    Obj {
+        /// The file.
+        path: PathBuf,
+        /// tobj's reason.
+        reason: String,
+    },
+    /// A vertex coordinate is NaN or infinite.
+    #[error("{path}:{line}: vertex coordinate is not a finite number: '{text}'")]
+    NonFinite {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line of the `v` statement.
+        line: usize,
+        /// The line as written.
+        text: String,
+    },
+    /// The file holds no triangle.
+    #[error("{path}: the mesh has no triangles (expected at least one 'f' line with 3 or more vertices)")]
+    Empty {
+        /// The file.
+        path: PathBuf,
+    },
+    /// A solid was needed but a part is open or inconsistently oriented.
+    #[error(
+        "{path}: object '{part}' is not a closed, consistently oriented surface \
+         ({detail}); a solid collider needs one"
+    )]
+    NotClosed {
+        /// The file.
+        path: PathBuf,
+        /// The object's name.
+        part: String,
+        /// What is wrong.
+        detail: String,
+    },
+    /// parry could not build the mesh.
+    #[error("{path}: object '{part}': {reason}")]
+    Build {
+        /// The file.
+        path: PathBuf,
+        /// The object's name.
+        part: String,
+        /// parry's reason.
+        reason: String,
+    },
+}
+
+/// Reads an OBJ file and places it.
+pub fn load_obj(path: &Path, placement: &Placement) -> Result<Vec<MeshPart>, MeshError> {
+    let text = std::fs::read_to_string(path).map_err(|source| MeshError::Io { path: path.to_path_buf(), source })?;
+    parse_obj(&text, path, placement)
+}
+
+/// Parses OBJ text (`path` only names it in errors) and places it.
+pub fn parse_obj(text: &str, path: &Path, placement: &Placement) -> Result<Vec<MeshPart>, MeshError> {
+    // tobj parses NaN happily and reports no lines, so finiteness is checked here, with one.
+    for (n, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if words.next() == Some("v") && words.take(3).any(|w| w.parse::<f64>().is_ok_and(|x| !x.is_finite())) {
+            return Err(MeshError::NonFinite { path: path.to_path_buf(), line: n + 1, text: line.trim().to_string() });
+        }
+    }
+    let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+    let (models, _materials) =
+        tobj::load_obj_buf(&mut Cursor::new(text), &options, |_| Ok(Default::default()))
+            .map_err(|e| MeshError::Obj { path: path.to_path_buf(), reason: e.to_string() })?;
+    let parts: Vec<MeshPart> = models
+        .into_iter()
+        .filter(|m| !m.mesh.indices.is_empty())
+        .map(|m| MeshPart {
+            name: m.name,
+            vertices: m
+                .mesh
+                .positions
+                .chunks_exact(3)
+                .map(|c| placement.apply(&Vec3::new(c[0], c[1], c[2])))
+                .collect(),
+            triangles: m.mesh.indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        })
+        .collect();
+    if parts.is_empty() {
+        return Err(MeshError::Empty { path: path.to_path_buf() });
+    }
+    Ok(parts)
+}

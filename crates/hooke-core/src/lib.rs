@@ -1,0 +1,53 @@
+//! # hooke-core: the mass-spring solver
+//!
+//! Particles as flat arrays, springs as index pairs, the forces of the physics contract
+//! (`shared/SPEC.md` §1: damped springs, gravity, a force field on a grid, penalty springs),
+//! four integrators (§4) and the three collision responses (§3). Units are SI throughout:
+//! metres, seconds, kilograms, newtons; scenes are +Y up.
+//!
+//! This crate knows nothing of parry3d, meshes, images, files or the command line: colliders
+//! come in through the [`Collider`] trait it owns, and it does no I/O.
+//!
+//! ## Quick start
+//!
+//! ```
+//! use hooke_core::*;
+//! // A 1 kg mass hanging from a pinned anchor by a 1 m spring of 100 N/m.
+//! let mut p = Particles::default();
+//! let anchor = p.push(Vec3::new(0.0, 2.0, 0.0), Vec3::zeros(), 1.0);
+//! p.pin(anchor);
+//! p.push(Vec3::new(0.0, 1.0, 0.0), Vec3::zeros(), 1.0);
+//! let spring = Spring { i: 0, j: 1, rest: 1.0, ks: 100.0, kd: 2.0, kind: SpringKind::Structural };
+//! let model = Model { springs: vec![spring], gravity: Vec3::new(0.0, -9.81, 0.0), ..Model::default() };
+//! let mut sim = Simulation::new(p, model, Integrator::Rk4, 1e-3);
+//! sim.advance(20_000).unwrap();
+//! // Settles at rest length + m g / k below the anchor.
+//! let y = sim.particles().x[1].y;
+//! assert!((y - (1.0 - 9.81 / 100.0)).abs() < 1e-6);
+//! ```
+//!
+//! ## Why is it slow?
+//!
+//! Build with `--release`: unoptimised nalgebra arithmetic is tens of times slower.
+
+mod collider;
+mod force_field;
+pub mod integrator;
+mod model;
+mod particles;
+mod response;
+mod simulation;
+mod spring;
+mod stability;
+mod summary;
+
+pub use collider::{Collider, Contact};
+pub use force_field::{FIELD_HALF_EXTENT, ForceField};
+pub use integrator::{Integrator, UnknownIntegrator, Workspace};
+pub use model::{Adjacency, ColliderSlot, Model};
+pub use particles::{Particles, Vec3};
+pub use response::Response;
+pub use simulation::{Divergence, SANE_BOUND, Simulation};
+pub use spring::{DEGENERATE_LENGTH, Spring, SpringKind};
+pub use stability::StabilityEstimate;
+pub use summary::Summary;

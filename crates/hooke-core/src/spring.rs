@@ -1,0 +1,82 @@
+//! Springs: index pairs with rest length, stiffness and damping (SPEC §1).
+
+use crate::particles::Vec3;
+
+/// What a spring holds together; used for drawing and statistics, never by the physics.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum SpringKind {
+    /// Between axis neighbours of a chain, grid or lattice.
+    Structural,
+    /// Along face or body diagonals; resists shearing.
+    Shear,
+    /// Between axis neighbours two apart; resists bending.
+    Bend,
+    /// Anything else (explicit pairs).
+    Other,
+}
+
+impl SpringKind {
+    /// All kinds, in a fixed order.
+    pub const ALL: [SpringKind; 4] = [Self::Structural, Self::Shear, Self::Bend, Self::Other];
+
+    /// The lowercase name used in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Structural => "structural",
+            Self::Shear => "shear",
+            Self::Bend => "bend",
+            Self::Other => "other",
+        }
+    }
+}
+
+/// A damped spring between particles `i` and `j`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spring {
+    /// First particle.
+    pub i: u32,
+    /// Second particle.
+    pub j: u32,
+    /// Rest length in metres.
+    pub rest: f64,
+    /// Stiffness in N/m.
+    pub ks: f64,
+    /// Damping along the spring in N·s/m.
+    pub kd: f64,
+    /// What the spring holds together.
+    pub kind: SpringKind,
+}
+
+/// Below this length a spring has no direction and adds no force (SPEC §1).
+pub const DEGENERATE_LENGTH: f64 = 1e-12;
+
+impl Spring {
+    /// The force on particle `i` (particle `j` receives its negation), exactly as SPEC §1:
+    /// `-ks (L - l) u - kd ((v_i - v_j) · u) u` with `u = (x_i - x_j) / L`.
+    ///
+    /// ```
+    /// use hooke_core::{Spring, SpringKind, Vec3};
+    /// let s = Spring { i: 0, j: 1, rest: 1.0, ks: 10.0, kd: 0.0, kind: SpringKind::Other };
+    /// // Stretched by 0.5 along +x: particle i is pulled back towards j.
+    /// let f = s.force(&Vec3::new(1.5, 0.0, 0.0), &Vec3::zeros(), &Vec3::zeros(), &Vec3::zeros());
+    /// assert_eq!(f, Vec3::new(-5.0, 0.0, 0.0));
+    /// ```
+    #[inline]
+    pub fn force(&self, xi: &Vec3, xj: &Vec3, vi: &Vec3, vj: &Vec3) -> Vec3 {
+        let d = xi - xj;
+        let len = d.norm();
+        if len < DEGENERATE_LENGTH {
+            return Vec3::zeros();
+        }
+        let u = d / len;
+        let elastic = -self.ks * (len - self.rest);
+        let damping = -self.kd * (vi - vj).dot(&u);
+        u * elastic + u * damping
+    }
+
+    /// Elastic potential energy `ks (L - l)² / 2` in joules.
+    pub fn energy(&self, xi: &Vec3, xj: &Vec3) -> f64 {
+        let stretch = (xi - xj).norm() - self.rest;
+        0.5 * self.ks * stretch * stretch
+    }
+}

@@ -1,0 +1,405 @@
+//! From a scene description to a ready-to-step simulation.
+
+use crate::generators::Lattice;
+use crate::spec::*;
+use hooke_collide::{BoxInterior, Cylinder, MeshError, Placement, Plane, TriMeshCollider};
+use hooke_core::{
+    ColliderSlot, Collider, ForceField, Model, Particles, Response, Simulation, Spring, SpringKind, Vec3,
+};
+use nalgebra::Rotation3;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+/// Most particles a scene may have: beyond this a typo (an extra zero in a size) would
+/// exhaust memory before anything useful happened.
+pub const MAX_PARTICLES: usize = 20_000_000;
+
+/// Meshes shipped inside Hooke, addressable as `builtin:NAME` from any scene file.
+pub const BUILTIN_MESHES: [(&str, &str); 2] = [
+    ("table.obj", include_str!("../../../assets/meshes/table.obj")),
+    ("square-table.obj", include_str!("../../../assets/meshes/square-table.obj")),
+];
+
+/// Why a scene description cannot be simulated.
+#[derive(Debug, thiserror::Error)]
+pub enum BuildError {
+    /// A value is inconsistent with the rest of the scene.
+    #[error("{key}: {message}")]
+    Invalid {
+        /// Where in the scene, e.g. `body[1].pins[3]`.
+        key: String,
+        /// What is wrong and what was expected.
+        message: String,
+    },
+    /// A mesh could not be loaded.
+    #[error("{key}: {source}")]
+    Mesh {
+        /// Where in the scene.
+        key: String,
+        /// The mesh error (names the file and, where it can, the line).
+        source: MeshError,
+    },
+}
+
+fn invalid(key: impl Into<String>, message: impl Into<String>) -> BuildError {
+    BuildError::Invalid { key: key.into(), message: message.into() }
+}
+
+/// How a body's particles are arranged, for drawing surfaces and picking subsets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Topology {
+    /// A chain of particles.
+    Chain,
+    /// A cloth grid `[nx, nz]`.
+    Grid([usize; 2]),
+    /// A jelly lattice `[nx, ny, nz]`.
+    Lattice([usize; 3]),
+    /// Unstructured points.
+    Points,
+}
+
+/// A body of a built scene: its name, where its particles are, how they are arranged.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    /// Name from the scene file.
+    pub name: String,
+    /// Its particles' indices in the simulation.
+    pub range: Range<usize>,
+    /// Arrangement.
+    pub topology: Topology,
+}
+
+/// The geometry of a collider, for drawing.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ColliderGeometry {
+    /// The ground plane at this height.
+    Ground(f64),
+    /// An inclined plane `[a, b, c, d]`.
+    Plane([f64; 4]),
+    /// The free box interior.
+    Box(BoxInterior),
+    /// An analytic cylinder tabletop.
+    Cylinder(Cylinder),
+    /// A triangle mesh, as world-space triangles.
+    Mesh(Vec<[Vec3; 3]>),
+}
+
+/// A scene ready to run: the simulation at step 0 and what is needed to run and draw it.
+#[derive(Debug)]
+pub struct Scene {
+    /// The description it was built from.
+    pub spec: SceneSpec,
+    /// The simulation at step 0.
+    pub simulation: Simulation,
+    /// Steps in a full run.
+    pub steps: u64,
+    /// A frame every this many steps.
+    pub every: u64,
+    /// The bodies.
+    pub bodies: Vec<Body>,
+    /// Collider geometry, in the order of the scene file.
+    pub colliders: Vec<ColliderGeometry>,
+}
+
+/// Overrides applied on top of a scene file, as from the command line.
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    /// Replace the integrator.
+    pub integrator: Option<hooke_core::Integrator>,
+    /// Replace the step size (seconds).
+    pub dt: Option<f64>,
+    /// Replace the run length with this many steps.
+    pub steps: Option<u64>,
+    /// Replace the run length with this duration (seconds).
+    pub duration: Option<f64>,
+    /// Replace the frame cadence.
+    pub every: Option<u64>,
+    /// Replace the mesh of every mesh collider with this OBJ file, or with the analytic cylinder
+    /// of the built-in table when the value is `cylinder`.
+    pub table: Option<String>,
+}
+
+impl Overrides {
+    /// Applies the overrides to a scene description.
+    pub fn apply(&self, spec: &mut SceneSpec) -> Result<(), BuildError> {
+        let sim = &mut spec.simulation;
+        if let Some(i) = self.integrator {
+            sim.integrator = IntegratorName(i);
+        }
+        if let Some(dt) = self.dt {
+            sim.dt = Positive::try_from(dt).map_err(|m| invalid("--dt", m))?;
+        }
+        if let Some(steps) = self.steps {
+            sim.steps = Some(steps);
+            sim.duration = None;
+        }
+        if let Some(t) = self.duration {
+            sim.duration = Some(Positive::try_from(t).map_err(|m| invalid("--duration", m))?);
+            sim.steps = None;
+        }
+        if let Some(every) = self.every {
+            sim.every = every;
+        }
+        if let Some(table) = &self.table {
+            let mut replaced = false;
+            for c in &mut spec.colliders {
+                if matches!(c.shape, ColliderShapeSpec::Mesh { .. } | ColliderShapeSpec::Cylinder { .. }) {
+                    c.shape = if table == "cylinder" {
+                        let r = hooke_collide::table::round::TOP_RADIUS;
+                        ColliderShapeSpec::Cylinder {
+                            center: [Finite(0.0), Finite(hooke_collide::table::round::TOP_Y), Finite(0.0)],
+                            radius: Positive(r),
+                            thickness: Positive(hooke_collide::table::round::TOP_THICKNESS),
+                        }
+                    } else {
+                        ColliderShapeSpec::Mesh {
+                            path: table.clone(),
+                            translate: [Finite(0.0); 3],
+                            rotate: [Finite(0.0); 3],
+                            scale: [Positive(1.0); 3],
+                        }
+                    };
+                    replaced = true;
+                }
+            }
+            if !replaced {
+                return Err(invalid("--table", format!("scene '{}' has no table (mesh or cylinder collider) to replace", spec.name)));
+            }
+        }
+        Ok(())
+    }
+}
+
+fn vec3(v: &[Finite; 3]) -> Vec3 {
+    Vec3::new(v[0].0, v[1].0, v[2].0)
+}
+
+fn rotation(degrees: &[Finite; 3]) -> Rotation3<f64> {
+    let r = vec3(degrees).map(f64::to_radians);
+    Rotation3::from_euler_angles(r.x, r.y, r.z)
+}
+
+impl SceneSpec {
+    /// Steps in a full run, from `steps` or `duration / dt` rounded to the nearest step.
+    pub fn total_steps(&self) -> Result<u64, BuildError> {
+        let sim = &self.simulation;
+        match (sim.steps, sim.duration) {
+            (Some(_), Some(_)) => Err(invalid("simulation", "give `steps` or `duration`, not both")),
+            (None, None) => Err(invalid("simulation", "expected `steps` or `duration` (the length of the run)")),
+            (Some(0), None) => Err(invalid("simulation.steps", "expected at least 1 step")),
+            (Some(n), None) => Ok(n),
+            (None, Some(t)) => {
+                let n = (t.0 / sim.dt.0).round();
+                if n < 1.0 || n > 1e15 {
+                    Err(invalid("simulation.duration", format!("{} s at dt = {} s is {n} steps; expected 1 to 1e15", t.0, sim.dt.0)))
+                } else {
+                    Ok(n as u64)
+                }
+            }
+        }
+    }
+
+    /// Builds the scene. Relative mesh paths are resolved against `base` (the scene file's
+    /// folder).
+    pub fn build(&self, base: &Path) -> Result<Scene, BuildError> {
+        let steps = self.total_steps()?;
+        let every = self.simulation.every;
+        if every == 0 {
+            return Err(invalid("simulation.every", "expected a frame cadence of at least 1 step"));
+        }
+        let mut particles = Particles::default();
+        let mut springs = Vec::new();
+        let mut bodies = Vec::new();
+        for (b, body) in self.bodies.iter().enumerate() {
+            let key = format!("body[{b}] '{}'", body.name);
+            let built = build_body(body, &key, particles.len())?;
+            let start = particles.len();
+            if start + built.local.len() > MAX_PARTICLES {
+                return Err(invalid(&key, format!("the scene would have more than {MAX_PARTICLES} particles")));
+            }
+            let r = rotation(&body.rotate);
+            let o = vec3(&body.origin);
+            let n = built.local.len();
+            if let Some(ps) = &body.positions
+                && ps.len() != n
+            {
+                return Err(invalid(format!("{key}.positions"), format!("expected {n} positions (one per particle), found {}", ps.len())));
+            }
+            if let Some(vs) = &body.velocities
+                && vs.len() != n
+            {
+                return Err(invalid(format!("{key}.velocities"), format!("expected {n} velocities (one per particle), found {}", vs.len())));
+            }
+            for (p, local) in built.local.iter().enumerate() {
+                let x = match &body.positions {
+                    Some(ps) => vec3(&ps[p]),
+                    None => o + r * local,
+                };
+                let v = body.velocities.as_ref().map_or(vec3(&body.velocity), |vs| vec3(&vs[p]));
+                particles.push(x, v, body.mass.0);
+            }
+            for (k, &pin) in body.pins.iter().enumerate() {
+                if pin >= n {
+                    return Err(invalid(format!("{key}.pins[{k}]"), format!("particle {pin} does not exist; the body has {n} (0 to {})", n - 1)));
+                }
+                particles.pin(start + pin);
+            }
+            springs.extend(built.springs);
+            bodies.push(Body { name: body.name.clone(), range: start..start + n, topology: built.topology });
+        }
+        let centroid = if particles.is_empty() { Vec3::zeros() } else { particles.centroid() };
+        let mut slots = Vec::new();
+        let mut geometry = Vec::new();
+        for (c, spec) in self.colliders.iter().enumerate() {
+            let key = format!("collider[{c}]");
+            let (shape, geo) = build_collider(&spec.shape, &key, base, &centroid)?;
+            let response = match spec.response {
+                ResponseSpec::Penalty { kc, dc } => Response::Penalty { kc: kc.0, dc: dc.0 },
+                ResponseSpec::Restitution { cr, friction } => Response::Restitution { cr: cr.0, friction: friction.0 },
+                ResponseSpec::Stick => Response::Stick,
+            };
+            slots.push(ColliderSlot { shape, response });
+            geometry.push(geo);
+        }
+        let field = match &self.force_field {
+            None => None,
+            Some(f) if f.resolution == 0 => None,
+            Some(f) => {
+                let values = f.values.iter().map(vec3).collect::<Vec<_>>();
+                let found = values.len();
+                Some(ForceField::new(f.resolution, values).ok_or_else(|| {
+                    invalid("force_field.values", format!("expected resolution³ = {} vectors, found {found}", f.resolution.saturating_pow(3)))
+                })?)
+            }
+        };
+        let model = Model {
+            springs,
+            gravity: vec3(&self.simulation.gravity),
+            drag: self.simulation.drag.0,
+            field,
+            colliders: slots,
+            ..Model::default()
+        };
+        let simulation = Simulation::new(particles, model, self.simulation.integrator.0, self.simulation.dt.0);
+        Ok(Scene { spec: self.clone(), simulation, steps, every, bodies, colliders: geometry })
+    }
+}
+
+struct BuiltBody {
+    local: Vec<Vec3>,
+    springs: Vec<Spring>,
+    topology: Topology,
+}
+
+fn build_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, BuildError> {
+    let (lattice, h, topology) = match &body.shape {
+        ShapeSpec::Chain { count, spacing } => (Lattice { size: [*count, 1, 1] }, spacing.0, Topology::Chain),
+        ShapeSpec::Grid { size, spacing } => (Lattice { size: [size[0], 1, size[1]] }, spacing.0, Topology::Grid(*size)),
+        ShapeSpec::Lattice { size, spacing } => (Lattice { size: *size }, spacing.0, Topology::Lattice(*size)),
+        ShapeSpec::Points { positions } => {
+            let local: Vec<Vec3> = positions.iter().map(vec3).collect();
+            if body.springs.structural.is_some() || body.springs.shear.is_some() || body.springs.bend.is_some() {
+                return Err(invalid(format!("{key}.springs"), "points have no topology: use explicit `pairs`, not structural/shear/bend"));
+            }
+            let springs = pairs(body, key, &local, offset)?;
+            return Ok(BuiltBody { local, springs, topology: Topology::Points });
+        }
+    };
+    let count = lattice.size.iter().try_fold(1usize, |acc, &n| acc.checked_mul(n));
+    match count {
+        Some(n) if (1..=MAX_PARTICLES).contains(&n) => {}
+        _ => return Err(invalid(format!("{key}.shape.size"), format!("expected 1 to {MAX_PARTICLES} particles, found size {:?}", lattice.size))),
+    }
+    let local = lattice.positions(h);
+    let mut springs = Vec::new();
+    for kind in [SpringKind::Structural, SpringKind::Shear, SpringKind::Bend] {
+        if let Some(p) = body.springs.params(kind) {
+            springs.extend(lattice.edges(kind, h).into_iter().map(|e| Spring {
+                i: (offset + e.i as usize) as u32,
+                j: (offset + e.j as usize) as u32,
+                rest: e.rest,
+                ks: p.ks.0,
+                kd: p.kd.0,
+                kind,
+            }));
+        }
+    }
+    springs.extend(pairs(body, key, &local, offset)?);
+    Ok(BuiltBody { local, springs, topology })
+}
+
+fn pairs(body: &BodySpec, key: &str, local: &[Vec3], offset: usize) -> Result<Vec<Spring>, BuildError> {
+    let n = local.len();
+    body.springs
+        .pairs
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            if p.i >= n || p.j >= n || p.i == p.j {
+                return Err(invalid(
+                    format!("{key}.springs.pairs[{k}]"),
+                    format!("expected two different particles below {n}, found i = {}, j = {}", p.i, p.j),
+                ));
+            }
+            let rest = p.rest.map_or_else(|| (local[p.i] - local[p.j]).norm(), |r| r.0);
+            Ok(Spring { i: (offset + p.i) as u32, j: (offset + p.j) as u32, rest, ks: p.ks.0, kd: p.kd.0, kind: SpringKind::Other })
+        })
+        .collect()
+}
+
+/// Where a mesh path points: a built-in mesh or a file.
+fn mesh_text(path: &str, base: &Path) -> Result<(String, PathBuf), MeshError> {
+    if let Some(name) = path.strip_prefix("builtin:") {
+        return match BUILTIN_MESHES.iter().find(|(n, _)| *n == name) {
+            Some((_, text)) => Ok((text.to_string(), PathBuf::from(path))),
+            None => Err(MeshError::Io {
+                path: PathBuf::from(path),
+                source: std::io::Error::new(
+                    std::io::ErrorKind::NotFound,
+                    format!("no built-in mesh '{name}'; built-in meshes: {}", BUILTIN_MESHES.map(|m| m.0).join(", ")),
+                ),
+            }),
+        };
+    }
+    let full = base.join(path);
+    let text = std::fs::read_to_string(&full).map_err(|source| MeshError::Io { path: full.clone(), source })?;
+    Ok((text, full))
+}
+
+fn build_collider(
+    shape: &ColliderShapeSpec,
+    key: &str,
+    base: &Path,
+    centroid: &Vec3,
+) -> Result<(Box<dyn Collider>, ColliderGeometry), BuildError> {
+    Ok(match shape {
+        ColliderShapeSpec::Ground { height } => (Box::new(Plane::ground(height.0)), ColliderGeometry::Ground(height.0)),
+        ColliderShapeSpec::Plane { coefficients } => {
+            let c = coefficients.map(|x| x.0);
+            let plane = Plane::inclined(c, centroid).ok_or_else(|| invalid(format!("{key}.shape.coefficients"), "expected a plane: (a, b, c) must not be all zero"))?;
+            (Box::new(plane), ColliderGeometry::Plane(c))
+        }
+        ColliderShapeSpec::Box { min, max } => {
+            let b = BoxInterior { min: vec3(min), max: vec3(max) };
+            if (0..3).any(|d| b.min[d] >= b.max[d]) {
+                return Err(invalid(format!("{key}.shape"), "expected min < max on every axis"));
+            }
+            (Box::new(b), ColliderGeometry::Box(b))
+        }
+        ColliderShapeSpec::Cylinder { center, radius, thickness } => {
+            let c = Cylinder { center: vec3(center), radius: radius.0, thickness: thickness.0 };
+            (Box::new(c), ColliderGeometry::Cylinder(c))
+        }
+        ColliderShapeSpec::Mesh { path, translate, rotate, scale } => {
+            let placement = Placement { translate: vec3(translate), rotate: vec3(rotate), scale: Vec3::new(scale[0].0, scale[1].0, scale[2].0) };
+            let mesh = || -> Result<TriMeshCollider, MeshError> {
+                let (text, full) = mesh_text(path, base)?;
+                let parts = hooke_collide::parse_obj(&text, &full, &placement)?;
+                TriMeshCollider::new(format!("mesh {path}"), parts, &full, false)
+            };
+            let mesh = mesh().map_err(|source| BuildError::Mesh { key: format!("{key}.shape.path"), source })?;
+            let tris = mesh.triangles();
+            (Box::new(mesh), ColliderGeometry::Mesh(tris))
+        }
+    })
+}

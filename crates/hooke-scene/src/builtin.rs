@@ -1,0 +1,202 @@
+//! The five built-in scenes of the course document, defined in code.
+//!
+//! Each is also shipped as `assets/scenes/<name>.toml` (written by `hooke scene NAME`), and a
+//! test checks that every file equals its built-in. Parameters were chosen so that each scene
+//! is stable with its own integrator and step (see `hooke check`), shows its point within a
+//! few seconds, and runs in about a second in a release build.
+
+use crate::spec::*;
+use hooke_core::Integrator;
+
+fn f3(v: [f64; 3]) -> [Finite; 3] {
+    v.map(Finite)
+}
+
+fn params(ks: f64, kd: f64) -> Option<SpringParams> {
+    Some(SpringParams { ks: NonNegative(ks), kd: NonNegative(kd) })
+}
+
+fn sim(integrator: Integrator, dt: f64, duration: f64, every: u64, drag: f64) -> SimulationSpec {
+    SimulationSpec {
+        integrator: IntegratorName(integrator),
+        dt: Positive(dt),
+        duration: Some(Positive(duration)),
+        steps: None,
+        every,
+        gravity: f3([0.0, -9.81, 0.0]),
+        drag: NonNegative(drag),
+    }
+}
+
+fn body(name: &str, mass: f64, origin: [f64; 3], shape: ShapeSpec, springs: SpringsSpec) -> BodySpec {
+    BodySpec {
+        name: name.into(),
+        mass: Positive(mass),
+        origin: f3(origin),
+        rotate: f3([0.0; 3]),
+        velocity: f3([0.0; 3]),
+        pins: Vec::new(),
+        positions: None,
+        velocities: None,
+        shape,
+        springs,
+    }
+}
+
+fn ground(cr: f64, friction: f64) -> ColliderSpec {
+    ColliderSpec {
+        shape: ColliderShapeSpec::Ground { height: Finite(0.0) },
+        response: ResponseSpec::Restitution { cr: Fraction(cr), friction: Fraction(friction) },
+    }
+}
+
+/// Anchor stiffness and mass of `single-spring`: `ω = √(k/m) = 10 rad/s`.
+pub const SINGLE_SPRING_KS: f64 = 100.0;
+/// Damping of `single-spring`: damping ratio `kd / (2 √(k m)) = 0.025`.
+pub const SINGLE_SPRING_KD: f64 = 0.5;
+
+/// A 1 kg mass on a 1 m spring from a fixed anchor at `(0, 2, 0)`, released 0.5 m stretched;
+/// it oscillates about `rest + m g / k` below the anchor and settles there.
+pub fn single_spring() -> SceneSpec {
+    let mut b = body(
+        "mass",
+        1.0,
+        [0.0, 2.0, 0.0],
+        ShapeSpec::Points { positions: vec![f3([0.0, 0.0, 0.0]), f3([0.0, -1.5, 0.0])] },
+        SpringsSpec::default(),
+    );
+    b.pins = vec![0];
+    b.springs.pairs = vec![PairSpec {
+        i: 0,
+        j: 1,
+        ks: NonNegative(SINGLE_SPRING_KS),
+        kd: NonNegative(SINGLE_SPRING_KD),
+        rest: Some(NonNegative(1.0)),
+    }];
+    SceneSpec {
+        name: "single-spring".into(),
+        description: "a 1 kg mass on a 100 N/m spring, released 0.5 m stretched; settles at rest length + mg/k".into(),
+        simulation: sim(Integrator::Symplectic, 1e-3, 20.0, 20, 0.0),
+        bodies: vec![b],
+        colliders: Vec::new(),
+        force_field: None,
+    }
+}
+
+/// Particles of `chain`, the anchor included.
+pub const CHAIN_COUNT: usize = 12;
+/// Mass of each chain particle, kg.
+pub const CHAIN_MASS: f64 = 0.05;
+/// Stiffness of each chain link, N/m.
+pub const CHAIN_KS: f64 = 2000.0;
+
+/// Twelve 50 g masses in a horizontal line from a fixed anchor, released: a chain pendulum
+/// that swings, whips, and comes to hang straight (light drag takes out the swing).
+pub fn chain() -> SceneSpec {
+    let mut b = body(
+        "chain",
+        CHAIN_MASS,
+        [0.0, 2.2, 0.0],
+        ShapeSpec::Chain { count: CHAIN_COUNT, spacing: Positive(0.15) },
+        SpringsSpec { structural: params(CHAIN_KS, 0.2), ..SpringsSpec::default() },
+    );
+    b.pins = vec![0];
+    SceneSpec {
+        name: "chain".into(),
+        description: "a chain pendulum of 12 masses released horizontal; swings and comes to hang straight".into(),
+        simulation: sim(Integrator::Symplectic, 2e-4, 12.0, 100, 0.03),
+        bodies: vec![b],
+        colliders: vec![ground(0.3, 0.2)],
+        force_field: None,
+    }
+}
+
+/// An 8×8×8 jelly cube of side 0.5 m and 1 kg, tilted and dropped on the ground, which it
+/// bounces off (restitution, as in the course) before settling without losing its shape.
+pub fn jello_cube() -> SceneSpec {
+    let mut b = body(
+        "jelly",
+        1.0 / 512.0,
+        [-0.15, 0.9, -0.25],
+        ShapeSpec::Lattice { size: [8, 8, 8], spacing: Positive(0.5 / 7.0) },
+        SpringsSpec { structural: params(300.0, 0.3), shear: params(300.0, 0.3), bend: params(150.0, 0.3), pairs: Vec::new() },
+    );
+    b.rotate = f3([30.0, 20.0, 35.0]);
+    SceneSpec {
+        name: "jello-cube".into(),
+        description: "an 8x8x8 jelly cube dropped tilted onto the ground; bounces, settles, keeps its shape".into(),
+        simulation: sim(Integrator::Symplectic, 2.5e-4, 3.0, 40, 0.0),
+        bodies: vec![b],
+        colliders: vec![ground(0.5, 0.3)],
+        force_field: None,
+    }
+}
+
+/// A 25×25 cloth of 1 m² and 0.5 kg, horizontal, pinned at its two corners on the x = 0
+/// edge: it swings down and settles into a drape.
+pub fn hanging_cloth() -> SceneSpec {
+    let n = 25;
+    let mut b = body(
+        "cloth",
+        0.5 / (n * n) as f64,
+        [-0.5, 2.0, -0.5],
+        ShapeSpec::Grid { size: [n, n], spacing: Positive(1.0 / (n - 1) as f64) },
+        SpringsSpec { structural: params(400.0, 0.02), shear: params(200.0, 0.02), bend: params(20.0, 0.005), pairs: Vec::new() },
+    );
+    b.pins = vec![0, n - 1];
+    SceneSpec {
+        name: "hanging-cloth".into(),
+        description: "a 25x25 cloth pinned at two corners, released flat; swings and settles into a drape".into(),
+        simulation: sim(Integrator::Symplectic, 2.5e-4, 6.0, 40, 0.002),
+        bodies: vec![b],
+        colliders: vec![ground(0.2, 0.5)],
+        force_field: None,
+    }
+}
+
+/// A 32×32 cloth of 1.6 m square dropped flat onto the round table (`builtin:table.obj`, top
+/// radius 0.6 m at y = 1): particles touching the table stick, the edges hang down.
+pub fn cloth_table() -> SceneSpec {
+    let n = 32;
+    let side = 1.6;
+    let b = body(
+        "cloth",
+        0.4 / (n * n) as f64,
+        [-side / 2.0, 1.3, -side / 2.0],
+        ShapeSpec::Grid { size: [n, n], spacing: Positive(side / (n - 1) as f64) },
+        SpringsSpec { structural: params(300.0, 0.02), shear: params(150.0, 0.02), bend: params(15.0, 0.005), pairs: Vec::new() },
+    );
+    SceneSpec {
+        name: "cloth-table".into(),
+        description: "a 32x32 cloth dropped onto a round table; the middle sticks to the top, the edges hang".into(),
+        simulation: sim(Integrator::Symplectic, 2.5e-4, 3.0, 40, 0.002),
+        bodies: vec![b],
+        colliders: vec![
+            ground(0.2, 0.5),
+            ColliderSpec {
+                shape: ColliderShapeSpec::Mesh {
+                    path: "builtin:table.obj".into(),
+                    translate: f3([0.0; 3]),
+                    rotate: f3([0.0; 3]),
+                    scale: [Positive(1.0); 3],
+                },
+                response: ResponseSpec::Stick,
+            },
+        ],
+        force_field: None,
+    }
+}
+
+/// The built-in scenes by name, in the course document's order.
+pub const BUILTINS: [(&str, fn() -> SceneSpec); 5] = [
+    ("single-spring", single_spring),
+    ("chain", chain),
+    ("jello-cube", jello_cube),
+    ("hanging-cloth", hanging_cloth),
+    ("cloth-table", cloth_table),
+];
+
+/// The built-in scene called `name`.
+pub fn builtin(name: &str) -> Option<SceneSpec> {
+    BUILTINS.iter().find(|(n, _)| *n == name).map(|(_, f)| f())
+}

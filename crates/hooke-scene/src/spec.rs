@@ -1,0 +1,389 @@
+//! The scene file format: what a `.toml` scene says, as serde types.
+//!
+//! Every table refuses unknown keys, and values are checked while they are read (positive
+//! step sizes and masses, finite numbers, known names), so a mistake is reported with the
+//! file's line and column. Units are SI; scenes are +Y up. See `assets/scenes/*.toml` for one
+//! complete example per built-in scene.
+
+use hooke_core::{Integrator, SpringKind};
+use serde::{Deserialize, Serialize};
+
+/// A finite `f64`, refused at read time when NaN or infinite.
+#[derive(Clone, Copy, Debug, PartialEq, PartialOrd, Serialize, Deserialize)]
+#[serde(try_from = "f64", into = "f64")]
+pub struct Finite(pub f64);
+
+impl TryFrom<f64> for Finite {
+    type Error = String;
+    fn try_from(x: f64) -> Result<Self, String> {
+        if x.is_finite() { Ok(Self(x)) } else { Err(format!("expected a finite number, found {x}")) }
+    }
+}
+
+impl From<Finite> for f64 {
+    fn from(x: Finite) -> f64 {
+        x.0
+    }
+}
+
+/// A finite `f64` greater than zero.
+#[derive(Clone, Copy, Debug, PartialEq, PartialOrd, Serialize, Deserialize)]
+#[serde(try_from = "f64", into = "f64")]
+pub struct Positive(pub f64);
+
+impl TryFrom<f64> for Positive {
+    type Error = String;
+    fn try_from(x: f64) -> Result<Self, String> {
+        if x.is_finite() && x > 0.0 { Ok(Self(x)) } else { Err(format!("expected a finite number > 0, found {x}")) }
+    }
+}
+
+impl From<Positive> for f64 {
+    fn from(x: Positive) -> f64 {
+        x.0
+    }
+}
+
+/// A finite `f64` at least zero.
+#[derive(Clone, Copy, Debug, PartialEq, PartialOrd, Serialize, Deserialize)]
+#[serde(try_from = "f64", into = "f64")]
+pub struct NonNegative(pub f64);
+
+impl TryFrom<f64> for NonNegative {
+    type Error = String;
+    fn try_from(x: f64) -> Result<Self, String> {
+        if x.is_finite() && x >= 0.0 { Ok(Self(x)) } else { Err(format!("expected a finite number >= 0, found {x}")) }
+    }
+}
+
+impl From<NonNegative> for f64 {
+    fn from(x: NonNegative) -> f64 {
+        x.0
+    }
+}
+
+/// A finite `f64` in `[0, 1]`.
+#[derive(Clone, Copy, Debug, PartialEq, PartialOrd, Serialize, Deserialize)]
+#[serde(try_from = "f64", into = "f64")]
+pub struct Fraction(pub f64);
+
+impl TryFrom<f64> for Fraction {
+    type Error = String;
+    fn try_from(x: f64) -> Result<Self, String> {
+        if (0.0..=1.0).contains(&x) { Ok(Self(x)) } else { Err(format!("expected a number in [0, 1], found {x}")) }
+    }
+}
+
+impl From<Fraction> for f64 {
+    fn from(x: Fraction) -> f64 {
+        x.0
+    }
+}
+
+/// An integrator name, checked at read time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub struct IntegratorName(pub Integrator);
+
+impl TryFrom<String> for IntegratorName {
+    type Error = String;
+    fn try_from(s: String) -> Result<Self, String> {
+        s.parse().map(Self).map_err(|e: hooke_core::UnknownIntegrator| e.to_string())
+    }
+}
+
+impl From<IntegratorName> for String {
+    fn from(i: IntegratorName) -> String {
+        i.0.name().to_string()
+    }
+}
+
+/// A whole scene file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSpec {
+    /// Short name, used in file names and messages.
+    pub name: String,
+    /// One sentence on what the scene shows.
+    #[serde(default)]
+    pub description: String,
+    /// Time stepping and global forces.
+    pub simulation: SimulationSpec,
+    /// The bodies, in order; particle indices run through them in this order.
+    #[serde(default, rename = "body")]
+    pub bodies: Vec<BodySpec>,
+    /// The colliders.
+    #[serde(default, rename = "collider")]
+    pub colliders: Vec<ColliderSpec>,
+    /// An optional force field on a grid over `[-2, 2]^3` (jello worlds).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force_field: Option<ForceFieldSpec>,
+}
+
+/// `[simulation]`: integrator, step size, length of the run, frame cadence, global forces.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationSpec {
+    /// `euler`, `symplectic`, `midpoint` or `rk4`.
+    pub integrator: IntegratorName,
+    /// Step size in seconds.
+    pub dt: Positive,
+    /// Length of the run in seconds (rounded to whole steps); give this or `steps`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub duration: Option<Positive>,
+    /// Length of the run in steps; give this or `duration`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steps: Option<u64>,
+    /// A frame every this many steps.
+    pub every: u64,
+    /// Gravitational acceleration in m/s² (default `[0, -9.81, 0]`).
+    #[serde(default = "default_gravity")]
+    pub gravity: [Finite; 3],
+    /// Linear drag on every particle in N·s/m (default 0).
+    #[serde(default = "zero", skip_serializing_if = "is_zero")]
+    pub drag: NonNegative,
+}
+
+fn default_gravity() -> [Finite; 3] {
+    [Finite(0.0), Finite(-9.81), Finite(0.0)]
+}
+
+fn zero() -> NonNegative {
+    NonNegative(0.0)
+}
+
+fn is_zero(x: &NonNegative) -> bool {
+    x.0 == 0.0
+}
+
+/// `[[body]]`: a set of particles made by one generator, and their springs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Name of the body.
+    pub name: String,
+    /// Mass of every particle in kg.
+    pub mass: Positive,
+    /// Where the generator's local origin goes, metres.
+    #[serde(default = "origin")]
+    pub origin: [Finite; 3],
+    /// Rotation of the generated shape about its local origin: degrees about x, then y, then z.
+    #[serde(default = "origin")]
+    pub rotate: [Finite; 3],
+    /// Initial velocity of every particle, m/s.
+    #[serde(default = "origin")]
+    pub velocity: [Finite; 3],
+    /// Pinned particles, as indices within the body.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pins: Vec<usize>,
+    /// Explicit initial positions overriding the generated ones (world coordinates); rest
+    /// lengths still come from the generated, undeformed shape.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub positions: Option<Vec<[Finite; 3]>>,
+    /// Explicit initial velocities overriding `velocity`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocities: Option<Vec<[Finite; 3]>>,
+    /// The generator: `chain`, `grid`, `lattice` or `points`.
+    pub shape: ShapeSpec,
+    /// Springs by topology and explicit pairs.
+    #[serde(default)]
+    pub springs: SpringsSpec,
+}
+
+fn origin() -> [Finite; 3] {
+    [Finite(0.0); 3]
+}
+
+/// How a body's particles are laid out (in its local frame, before `rotate` and `origin`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum ShapeSpec {
+    /// `count` particles along local +x, `spacing` apart, the first at the origin.
+    Chain {
+        /// Number of particles.
+        count: usize,
+        /// Distance between neighbours, metres.
+        spacing: Positive,
+    },
+    /// A cloth: `size[0] × size[1]` particles in the local x-z plane; particle `(i, j)` at
+    /// `(i h, 0, j h)`, index `i size[1] + j`.
+    Grid {
+        /// Particles along x and z.
+        size: [usize; 2],
+        /// Spacing `h`, metres.
+        spacing: Positive,
+    },
+    /// A jelly block: `size[0] × size[1] × size[2]` particles; `(i, j, k)` at `(i h, j h, k h)`,
+    /// index `(i size[1] + j) size[2] + k`.
+    Lattice {
+        /// Particles along x, y and z.
+        size: [usize; 3],
+        /// Spacing `h`, metres.
+        spacing: Positive,
+    },
+    /// Explicit particles in the local frame.
+    Points {
+        /// Positions, metres.
+        positions: Vec<[Finite; 3]>,
+    },
+}
+
+/// Stiffness and damping of a family of springs.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringParams {
+    /// Stiffness in N/m.
+    pub ks: NonNegative,
+    /// Damping along the spring in N·s/m.
+    pub kd: NonNegative,
+}
+
+/// `[body.springs]`: which springs the generator makes, plus explicit ones.
+///
+/// Structural springs join axis neighbours; shear springs the face diagonals of a grid, and
+/// the face and body diagonals of a lattice; bend springs axis neighbours two apart. Rest
+/// lengths are the distances in the generated (undeformed) shape.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringsSpec {
+    /// Springs between axis neighbours.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub structural: Option<SpringParams>,
+    /// Springs along diagonals.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear: Option<SpringParams>,
+    /// Springs between axis neighbours two apart.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bend: Option<SpringParams>,
+    /// Explicit springs between particles of this body.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pairs: Vec<PairSpec>,
+}
+
+/// One explicit spring.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PairSpec {
+    /// First particle (index within the body).
+    pub i: usize,
+    /// Second particle.
+    pub j: usize,
+    /// Stiffness in N/m.
+    pub ks: NonNegative,
+    /// Damping in N·s/m.
+    pub kd: NonNegative,
+    /// Rest length in metres (default: the initial distance).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rest: Option<NonNegative>,
+}
+
+/// `[[collider]]`: a shape and the response it triggers.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColliderSpec {
+    /// The shape.
+    pub shape: ColliderShapeSpec,
+    /// What it does to particles that violate it.
+    pub response: ResponseSpec,
+}
+
+/// A collider's geometry.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum ColliderShapeSpec {
+    /// The plane `y = height`, solid below.
+    Ground {
+        /// Height in metres.
+        height: Finite,
+    },
+    /// The plane `a x + b y + c z + d = 0`; the side holding the particles' initial centroid
+    /// is free.
+    Plane {
+        /// `[a, b, c, d]`.
+        coefficients: [Finite; 4],
+    },
+    /// The inside of an axis-aligned box is free; outside is solid.
+    Box {
+        /// Lower corner, metres.
+        min: [Finite; 3],
+        /// Upper corner, metres.
+        max: [Finite; 3],
+    },
+    /// The analytic cylinder tabletop.
+    Cylinder {
+        /// Centre of the top face, metres.
+        center: [Finite; 3],
+        /// Radius, metres.
+        radius: Positive,
+        /// Thickness, metres.
+        thickness: Positive,
+    },
+    /// A triangle mesh from an OBJ file. `path` is relative to the scene file; `builtin:NAME`
+    /// names a mesh shipped inside Hooke (`builtin:table.obj`, `builtin:square-table.obj`).
+    Mesh {
+        /// The OBJ file.
+        path: String,
+        /// Translation, metres.
+        #[serde(default = "origin")]
+        translate: [Finite; 3],
+        /// Rotation in degrees about x, then y, then z.
+        #[serde(default = "origin")]
+        rotate: [Finite; 3],
+        /// Scale per axis.
+        #[serde(default = "unit")]
+        scale: [Positive; 3],
+    },
+}
+
+fn unit() -> [Positive; 3] {
+    [Positive(1.0); 3]
+}
+
+/// A collision response (SPEC §3).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum ResponseSpec {
+    /// Penalty spring `kc δ n - dc (v·n) n`.
+    Penalty {
+        /// Stiffness in N/m.
+        kc: NonNegative,
+        /// Damping in N·s/m.
+        dc: NonNegative,
+    },
+    /// Projection and restitution after each step.
+    Restitution {
+        /// Coefficient of restitution.
+        cr: Fraction,
+        /// Fraction of tangential velocity removed per contact (default 0).
+        #[serde(default = "no_friction")]
+        friction: Fraction,
+    },
+    /// Projection and a full stop after each step.
+    Stick,
+}
+
+fn no_friction() -> Fraction {
+    Fraction(0.0)
+}
+
+/// `[force_field]`: `resolution³` force vectors in newtons, in file order.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ForceFieldSpec {
+    /// Nodes per axis.
+    pub resolution: usize,
+    /// The vectors, node `(a, b, c)` at index `a r² + b r + c`.
+    pub values: Vec<[Finite; 3]>,
+}
+
+impl SpringsSpec {
+    /// The parameters of one family.
+    pub fn params(&self, kind: SpringKind) -> Option<SpringParams> {
+        match kind {
+            SpringKind::Structural => self.structural,
+            SpringKind::Shear => self.shear,
+            SpringKind::Bend => self.bend,
+            SpringKind::Other => None,
+        }
+    }
+}
