@@ -62,6 +62,6 @@ pub fn load_scene(path: &Path) -> Result<SceneSpec, SceneError> {
 
 /// The scene as TOML text, with a header naming it; [`parse_scene`] reads it back equal.
 pub fn to_toml(spec: &SceneSpec) -> String {
-    let body = toml::to_string_pretty(spec).expect("scene specs always serialise");
+    let body = toml::to_string(spec).expect("scene specs always serialise");
     format!("# Hooke scene '{}': {}\n# Format: see crates/hooke-scene/src/spec.rs and the README.\n\n{body}", spec.name, spec.description)
 }

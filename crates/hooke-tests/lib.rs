@@ -1,0 +1,1 @@
+//! Empty: the validation suite lives in the workspace's `tests/` folder.

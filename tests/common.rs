@@ -1,0 +1,26 @@
+//! Helpers shared by the suite.
+
+use hooke_scene::{Overrides, Scene, SceneSpec};
+use std::path::{Path, PathBuf};
+
+/// The workspace root, found from this crate's manifest, never the working directory.
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().unwrap()
+}
+
+/// A built-in scene, with overrides, built.
+pub fn builtin(name: &str, overrides: &Overrides) -> Scene {
+    let mut spec: SceneSpec = hooke_scene::builtin::builtin(name).unwrap();
+    overrides.apply(&mut spec).unwrap();
+    spec.build(&root().join("assets/scenes")).unwrap()
+}
+
+/// Rounds to `digits` significant digits, for snapshots that must not depend on the last bits
+/// of libm's trigonometry on another platform.
+pub fn round_sig(x: f64, digits: i32) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let scale = 10f64.powi(digits - 1 - x.abs().log10().floor() as i32);
+    (x * scale).round() / scale
+}
