@@ -4,7 +4,9 @@
 use crate::common::{builtin, root};
 use hooke_collide::table::round;
 use hooke_collide::{Cylinder, Placement, Plane};
-use hooke_core::{Collider, ColliderSlot, Integrator, Model, Particles, Response, Simulation, Vec3};
+use hooke_core::{
+    Collider, ColliderSlot, Integrator, Model, Particles, Response, Simulation, Vec3,
+};
 use hooke_scene::Overrides;
 
 #[test]
@@ -12,8 +14,15 @@ fn restitution_apex_heights_fall_as_cr_to_the_2n() {
     let (h0, cr) = (1.0, 0.8);
     let mut p = Particles::default();
     p.push(Vec3::new(0.0, h0, 0.0), Vec3::zeros(), 1.0);
-    let ground = ColliderSlot { shape: Box::new(Plane::ground(0.0)), response: Response::Restitution { cr, friction: 0.0 } };
-    let model = Model { gravity: Vec3::new(0.0, -9.81, 0.0), colliders: vec![ground], ..Model::default() };
+    let ground = ColliderSlot {
+        shape: Box::new(Plane::ground(0.0)),
+        response: Response::Restitution { cr, friction: 0.0 },
+    };
+    let model = Model {
+        gravity: Vec3::new(0.0, -9.81, 0.0),
+        colliders: vec![ground],
+        ..Model::default()
+    };
     let mut sim = Simulation::new(p, model, Integrator::Symplectic, 1e-5);
     let mut apexes = Vec::new();
     let mut last_vy = 0.0;
@@ -29,16 +38,28 @@ fn restitution_apex_heights_fall_as_cr_to_the_2n() {
         let expected = cr.powi(2 * (n as i32 + 1)) * h0;
         // An impact lands between steps: the speed is off by up to g dt, the height by
         // about 2 v g dt / g, 1e-4 m here.
-        assert!((apex - expected).abs() < 2e-4, "apex {}: {apex}, expected {expected}", n + 1);
+        assert!(
+            (apex - expected).abs() < 2e-4,
+            "apex {}: {apex}, expected {expected}",
+            n + 1
+        );
     }
 }
 
 fn round_table() -> hooke_collide::TriMeshCollider {
-    hooke_collide::load_mesh(&root().join("assets/meshes/table.obj"), &Placement::default()).unwrap()
+    hooke_collide::load_mesh(
+        &root().join("assets/meshes/table.obj"),
+        &Placement::default(),
+    )
+    .unwrap()
 }
 
 fn analytic_top() -> Cylinder {
-    Cylinder { center: Vec3::new(0.0, round::TOP_Y, 0.0), radius: round::TOP_RADIUS, thickness: round::TOP_THICKNESS }
+    Cylinder {
+        center: Vec3::new(0.0, round::TOP_Y, 0.0),
+        radius: round::TOP_RADIUS,
+        thickness: round::TOP_THICKNESS,
+    }
 }
 
 /// The rim of the 64-gon lies inside the circle by up to `R (1 - cos(π/64))`.
@@ -54,26 +75,45 @@ fn the_obj_table_agrees_with_the_analytic_cylinder() {
     for i in 0..=60 {
         for j in 0..=60 {
             for k in 0..=30 {
-                let p = Vec3::new(-0.7 + 1.4 * i as f64 / 60.0, 0.93 + 0.1 * k as f64 / 30.0, -0.7 + 1.4 * j as f64 / 60.0);
+                let p = Vec3::new(
+                    -0.7 + 1.4 * i as f64 / 60.0,
+                    0.93 + 0.1 * k as f64 / 30.0,
+                    -0.7 + 1.4 * j as f64 / 60.0,
+                );
                 let r = (p.x * p.x + p.z * p.z).sqrt();
                 // Probes within the tessellation error of the rim, or on a face, may differ.
                 let near_rim = (r - round::TOP_RADIUS).abs() < tol;
-                let near_face = (p.y - round::TOP_Y).abs() < 1e-9 || (p.y - (round::TOP_Y - round::TOP_THICKNESS)).abs() < 1e-9;
+                let near_face = (p.y - round::TOP_Y).abs() < 1e-9
+                    || (p.y - (round::TOP_Y - round::TOP_THICKNESS)).abs() < 1e-9;
                 // The pedestal below the top is in the mesh only.
-                if near_rim || near_face || p.y < round::TOP_Y - round::TOP_THICKNESS && r < round::PEDESTAL_RADIUS + 1e-3 {
+                if near_rim
+                    || near_face
+                    || p.y < round::TOP_Y - round::TOP_THICKNESS
+                        && r < round::PEDESTAL_RADIUS + 1e-3
+                {
                     continue;
                 }
                 compared += 1;
-                assert_eq!(mesh.inside(&p), cylinder.inside(&p), "contact decision differs at {p}");
+                assert_eq!(
+                    mesh.inside(&p),
+                    cylinder.inside(&p),
+                    "contact decision differs at {p}"
+                );
                 if cylinder.inside(&p) {
                     inside += 1;
                     let (dm, dc) = (mesh.depth(&p), cylinder.depth(&p));
-                    assert!((dm - dc).abs() <= tol, "depth differs at {p}: mesh {dm}, cylinder {dc}");
+                    assert!(
+                        (dm - dc).abs() <= tol,
+                        "depth differs at {p}: mesh {dm}, cylinder {dc}"
+                    );
                 }
             }
         }
     }
-    assert!(compared > 100_000 && inside > 10_000, "compared {compared}, inside {inside}");
+    assert!(
+        compared > 100_000 && inside > 10_000,
+        "compared {compared}, inside {inside}"
+    );
 }
 
 #[test]
@@ -87,44 +127,104 @@ fn no_cloth_particle_ends_up_inside_the_table_top() {
             let r = (x.x * x.x + x.z * x.z).sqrt();
             // Inside the radius (less the tessellation error) and within the slab: inside.
             if r < top.radius - tessellation_error() {
-                assert!(top.depth(x) < 1e-9, "frame {frame}: particle at {x} is {} m inside the top", top.depth(x));
+                assert!(
+                    top.depth(x) < 1e-9,
+                    "frame {frame}: particle at {x} is {} m inside the top",
+                    top.depth(x)
+                );
             }
         }
-        on_top = scene.simulation.particles().x.iter().filter(|x| (x.y - round::TOP_Y).abs() < 1e-6).count();
+        on_top = scene
+            .simulation
+            .particles()
+            .x
+            .iter()
+            .filter(|x| (x.y - round::TOP_Y).abs() < 1e-6)
+            .count();
     }
     // The middle of the cloth lies on the top: about π R² / h² = 420 particles.
     assert!(on_top > 250, "only {on_top} particles rest on the top");
-    let lowest = scene.simulation.particles().x.iter().map(|x| x.y).fold(f64::INFINITY, f64::min);
-    assert!(lowest < round::TOP_Y - 0.3, "the edges should hang down; lowest particle at {lowest}");
+    let lowest = scene
+        .simulation
+        .particles()
+        .x
+        .iter()
+        .map(|x| x.y)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        lowest < round::TOP_Y - 0.3,
+        "the edges should hang down; lowest particle at {lowest}"
+    );
 }
 
 #[test]
 fn the_analytic_cylinder_table_gives_the_same_drape() {
     let run = |table: Option<&str>| {
-        let mut scene = builtin("cloth-table", &Overrides { table: table.map(String::from), duration: Some(1.5), ..Overrides::default() });
+        let mut scene = builtin(
+            "cloth-table",
+            &Overrides {
+                table: table.map(String::from),
+                duration: Some(1.5),
+                ..Overrides::default()
+            },
+        );
         scene.simulation.advance(scene.steps).unwrap();
         scene.simulation.particles().x.clone()
     };
     let (mesh, cylinder) = (run(None), run(Some("cylinder")));
-    let stuck = |x: &[Vec3]| x.iter().filter(|p| (p.y - round::TOP_Y).abs() < 1e-6).count();
+    let stuck = |x: &[Vec3]| {
+        x.iter()
+            .filter(|p| (p.y - round::TOP_Y).abs() < 1e-6)
+            .count()
+    };
     let (a, b) = (stuck(&mesh), stuck(&cylinder));
-    assert!(a.abs_diff(b) <= 8, "particles on the top: mesh {a}, cylinder {b}");
+    assert!(
+        a.abs_diff(b) <= 8,
+        "particles on the top: mesh {a}, cylinder {b}"
+    );
 }
 
 #[test]
 fn cloth_table_runs_on_a_swapped_square_table() {
     let path = root().join("assets/meshes/square-table.obj");
-    let mut scene = builtin("cloth-table", &Overrides { table: Some(path.display().to_string()), duration: Some(1.5), ..Overrides::default() });
+    let mut scene = builtin(
+        "cloth-table",
+        &Overrides {
+            table: Some(path.display().to_string()),
+            duration: Some(1.5),
+            ..Overrides::default()
+        },
+    );
     scene.simulation.advance(scene.steps).unwrap();
     let top = hooke_collide::table::square::TOP_Y;
     let half = hooke_collide::table::square::HALF_SIDE;
     let x = &scene.simulation.particles().x;
-    let on_top = x.iter().filter(|p| (p.y - top).abs() < 1e-6 && p.x.abs() < half && p.z.abs() < half).count();
+    let on_top = x
+        .iter()
+        .filter(|p| (p.y - top).abs() < 1e-6 && p.x.abs() < half && p.z.abs() < half)
+        .count();
     // A 1 m square top holds 400 particles of the cloth; sticking stops them sliding, so the
     // cloth landing last buckles into folds about 2 cm high and 184 touch the top.
-    assert!(on_top > 150, "only {on_top} particles rest on the square top");
-    let at_round_height = x.iter().filter(|p| (p.y - round::TOP_Y).abs() < 1e-6).count();
-    assert_eq!(at_round_height, 0, "particles rest at the old round table's height");
-    let inside = x.iter().filter(|p| p.x.abs() < half - 1e-3 && p.z.abs() < half - 1e-3 && p.y < top - 1e-6 && p.y > top - 0.04).count();
+    assert!(
+        on_top > 150,
+        "only {on_top} particles rest on the square top"
+    );
+    let at_round_height = x
+        .iter()
+        .filter(|p| (p.y - round::TOP_Y).abs() < 1e-6)
+        .count();
+    assert_eq!(
+        at_round_height, 0,
+        "particles rest at the old round table's height"
+    );
+    let inside = x
+        .iter()
+        .filter(|p| {
+            p.x.abs() < half - 1e-3
+                && p.z.abs() < half - 1e-3
+                && p.y < top - 1e-6
+                && p.y > top - 0.04
+        })
+        .count();
     assert_eq!(inside, 0, "particles inside the square top");
 }

@@ -5,7 +5,10 @@ use std::path::{Path, PathBuf};
 
 /// The workspace root, found from this crate's manifest, never the working directory.
 pub fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().unwrap()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .canonicalize()
+        .unwrap()
 }
 
 /// A built-in scene, with overrides, built.

@@ -5,7 +5,9 @@ use hooke_scene::spec::Finite;
 use hooke_scene::{Overrides, SceneSpec};
 
 fn momentum(p: &Particles) -> Vec3 {
-    p.v.iter().zip(&p.mass).fold(Vec3::zeros(), |acc, (v, m)| acc + v * *m)
+    p.v.iter()
+        .zip(&p.mass)
+        .fold(Vec3::zeros(), |acc, (v, m)| acc + v * *m)
 }
 
 #[test]
@@ -19,18 +21,30 @@ fn a_free_spinning_jelly_conserves_momentum() {
         (0..512)
             .map(|i| {
                 let t = i as f64;
-                [Finite(1.0 + (t * 0.37).sin()), Finite(2.0 + (t * 0.61).cos()), Finite(-0.5 + (t * 0.23).sin())]
+                [
+                    Finite(1.0 + (t * 0.37).sin()),
+                    Finite(2.0 + (t * 0.61).cos()),
+                    Finite(-0.5 + (t * 0.23).sin()),
+                ]
             })
             .collect(),
     );
     for integrator in Integrator::ALL {
         let mut s = spec.clone();
-        Overrides { integrator: Some(integrator), ..Overrides::default() }.apply(&mut s).unwrap();
+        Overrides {
+            integrator: Some(integrator),
+            ..Overrides::default()
+        }
+        .apply(&mut s)
+        .unwrap();
         let mut scene = s.build(std::path::Path::new(".")).unwrap();
         let p0 = momentum(scene.simulation.particles());
         scene.simulation.advance(2000).unwrap();
         let p1 = momentum(scene.simulation.particles());
-        assert!((p1 - p0).norm() < 1e-12, "{integrator}: momentum {p0} -> {p1}");
+        assert!(
+            (p1 - p0).norm() < 1e-12,
+            "{integrator}: momentum {p0} -> {p1}"
+        );
     }
 }
 
@@ -38,8 +52,23 @@ fn undamped_pair(integrator: Integrator) -> Simulation {
     let mut p = Particles::default();
     p.push(Vec3::new(0.0, 0.0, 0.0), Vec3::zeros(), 1.0);
     p.push(Vec3::new(1.5, 0.0, 0.0), Vec3::zeros(), 1.0);
-    let spring = Spring { i: 0, j: 1, rest: 1.0, ks: 100.0, kd: 0.0, kind: SpringKind::Other };
-    Simulation::new(p, Model { springs: vec![spring], ..Model::default() }, integrator, 1e-2)
+    let spring = Spring {
+        i: 0,
+        j: 1,
+        rest: 1.0,
+        ks: 100.0,
+        kd: 0.0,
+        kind: SpringKind::Other,
+    };
+    Simulation::new(
+        p,
+        Model {
+            springs: vec![spring],
+            ..Model::default()
+        },
+        integrator,
+        1e-2,
+    )
 }
 
 fn energy(sim: &Simulation) -> f64 {
@@ -61,19 +90,48 @@ fn symplectic_energy_stays_bounded_while_explicit_euler_grows() {
     // ω dt = 0.14: symplectic Euler's energy oscillates within O(ω dt) and never drifts.
     assert!(worst < 0.1, "symplectic energy drifted by {worst}");
     // Explicit Euler multiplies the energy by 1 + ω²dt² = 1.02 per step: ×4e8 over 10 s.
-    assert!(energy(&euler) > 100.0 * e0, "explicit Euler energy {} from {e0}", energy(&euler));
+    assert!(
+        energy(&euler) > 100.0 * e0,
+        "explicit Euler energy {} from {e0}",
+        energy(&euler)
+    );
 }
 
 #[test]
 fn spring_forces_pull_stretched_ends_together_and_damp_separation() {
-    let s = Spring { i: 0, j: 1, rest: 1.0, ks: 10.0, kd: 2.0, kind: SpringKind::Other };
+    let s = Spring {
+        i: 0,
+        j: 1,
+        rest: 1.0,
+        ks: 10.0,
+        kd: 2.0,
+        kind: SpringKind::Other,
+    };
     let (xi, xj) = (Vec3::new(2.0, 0.0, 0.0), Vec3::zeros());
     let f = s.force(&xi, &xj, &Vec3::zeros(), &Vec3::zeros());
-    assert_eq!(f, Vec3::new(-10.0, 0.0, 0.0), "stretched: i pulled towards j");
-    let f = s.force(&Vec3::new(0.5, 0.0, 0.0), &xj, &Vec3::zeros(), &Vec3::zeros());
+    assert_eq!(
+        f,
+        Vec3::new(-10.0, 0.0, 0.0),
+        "stretched: i pulled towards j"
+    );
+    let f = s.force(
+        &Vec3::new(0.5, 0.0, 0.0),
+        &xj,
+        &Vec3::zeros(),
+        &Vec3::zeros(),
+    );
     assert_eq!(f, Vec3::new(5.0, 0.0, 0.0), "compressed: i pushed away");
-    let f = s.force(&Vec3::new(1.0, 0.0, 0.0), &xj, &Vec3::new(3.0, 1.0, 0.0), &Vec3::zeros());
-    assert_eq!(f, Vec3::new(-6.0, 0.0, 0.0), "separating at 3 m/s: damped along the spring only");
+    let f = s.force(
+        &Vec3::new(1.0, 0.0, 0.0),
+        &xj,
+        &Vec3::new(3.0, 1.0, 0.0),
+        &Vec3::zeros(),
+    );
+    assert_eq!(
+        f,
+        Vec3::new(-6.0, 0.0, 0.0),
+        "separating at 3 m/s: damped along the spring only"
+    );
     let f = s.force(&xj, &xj, &Vec3::new(1.0, 0.0, 0.0), &Vec3::zeros());
     assert_eq!(f, Vec3::zeros(), "coincident ends: no force, no NaN");
 }
@@ -87,7 +145,12 @@ fn the_chain_hangs_with_the_static_stretch_of_its_load() {
     let n = hooke_scene::builtin::CHAIN_COUNT - 1;
     for j in 1..=n {
         let length = (p.x[j] - p.x[j - 1]).norm();
-        let expected = 0.15 + (n - j + 1) as f64 * hooke_scene::builtin::CHAIN_MASS * 9.81 / hooke_scene::builtin::CHAIN_KS;
-        assert!((length - expected).abs() < 2e-4, "spring {j}: length {length}, expected {expected}");
+        let expected = 0.15
+            + (n - j + 1) as f64 * hooke_scene::builtin::CHAIN_MASS * 9.81
+                / hooke_scene::builtin::CHAIN_KS;
+        assert!(
+            (length - expected).abs() < 2e-4,
+            "spring {j}: length {length}, expected {expected}"
+        );
     }
 }

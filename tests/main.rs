@@ -3,9 +3,9 @@
 //! One test binary (fast to link) with a module per concern. Physics tests compare with
 //! closed forms; snapshot tests lock real trajectories (see `tests/snapshots/`).
 
-mod common;
-mod oscillator;
-mod conservation;
 mod collisions;
+mod common;
+mod conservation;
+mod oscillator;
 mod scenes;
 mod worlds;

@@ -27,7 +27,15 @@ fn exact_y(t: f64) -> f64 {
 
 fn error_at(integrator: Integrator, dt: f64, t_end: f64) -> f64 {
     let steps = (t_end / dt).round() as u64;
-    let mut scene = builtin("single-spring", &Overrides { integrator: Some(integrator), dt: Some(dt), steps: Some(steps), ..Overrides::default() });
+    let mut scene = builtin(
+        "single-spring",
+        &Overrides {
+            integrator: Some(integrator),
+            dt: Some(dt),
+            steps: Some(steps),
+            ..Overrides::default()
+        },
+    );
     scene.simulation.advance(steps).unwrap();
     let y = scene.simulation.particles().x[1].y;
     (y - exact_y(scene.simulation.time())).abs()
@@ -53,7 +61,10 @@ fn single_spring_settles_at_rest_length_plus_mg_over_k() {
     scene.simulation.advance(scene.steps).unwrap();
     let y = scene.simulation.particles().x[1].y;
     let expected = ANCHOR_Y - REST - MASS * G / SINGLE_SPRING_KS;
-    assert!((y - expected).abs() < 1e-4, "settled at {y}, expected {expected}");
+    assert!(
+        (y - expected).abs() < 1e-4,
+        "settled at {y}, expected {expected}"
+    );
 }
 
 #[test]
@@ -65,11 +76,17 @@ fn each_integrator_converges_at_its_order() {
         (Integrator::Midpoint, 4e-3),
         (Integrator::Rk4, 2e-2),
     ] {
-        let errors: Vec<f64> = [1.0, 0.5, 0.25].iter().map(|s| error_at(integrator, dt * s, 1.0)).collect();
+        let errors: Vec<f64> = [1.0, 0.5, 0.25]
+            .iter()
+            .map(|s| error_at(integrator, dt * s, 1.0))
+            .collect();
         for pair in errors.windows(2) {
             let slope = (pair[0] / pair[1]).log2();
             let order = integrator.order() as f64;
-            assert!((slope - order).abs() < 0.3, "{integrator}: errors {errors:?}, slope {slope}, expected {order}");
+            assert!(
+                (slope - order).abs() < 0.3,
+                "{integrator}: errors {errors:?}, slope {slope}, expected {order}"
+            );
         }
     }
 }

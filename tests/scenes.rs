@@ -12,7 +12,12 @@ fn every_shipped_scene_file_equals_its_builtin() {
     for (name, make) in BUILTINS {
         let path = root().join(format!("assets/scenes/{name}.toml"));
         let spec = hooke_scene::load_scene(&path).unwrap();
-        assert_eq!(spec, make(), "{} differs from the built-in; regenerate it with `hooke scene {name}`", path.display());
+        assert_eq!(
+            spec,
+            make(),
+            "{} differs from the built-in; regenerate it with `hooke scene {name}`",
+            path.display()
+        );
     }
 }
 
@@ -20,7 +25,11 @@ fn every_shipped_scene_file_equals_its_builtin() {
 fn printed_scenes_read_back_identical() {
     for (name, make) in BUILTINS {
         let text = hooke_scene::to_toml(&make());
-        assert_eq!(hooke_scene::parse_scene(&text, name).unwrap(), make(), "{name}");
+        assert_eq!(
+            hooke_scene::parse_scene(&text, name).unwrap(),
+            make(),
+            "{name}"
+        );
     }
 }
 
@@ -63,8 +72,23 @@ pub fn trajectory_report(scene: &mut Scene, checkpoints: &[u64]) -> String {
         sim.advance(step - sim.steps()).unwrap();
         let s = Summary::of(sim.model(), sim.particles());
         let _ = writeln!(out, "step {step} t={}", r(sim.time()));
-        let _ = writeln!(out, "  kinetic {} potential {} max_speed {}", r(s.kinetic), r(s.potential), r(s.max_speed));
-        let _ = writeln!(out, "  bbox [{}, {}, {}] .. [{}, {}, {}]", r(s.min.x), r(s.min.y), r(s.min.z), r(s.max.x), r(s.max.y), r(s.max.z));
+        let _ = writeln!(
+            out,
+            "  kinetic {} potential {} max_speed {}",
+            r(s.kinetic),
+            r(s.potential),
+            r(s.max_speed)
+        );
+        let _ = writeln!(
+            out,
+            "  bbox [{}, {}, {}] .. [{}, {}, {}]",
+            r(s.min.x),
+            r(s.min.y),
+            r(s.min.z),
+            r(s.max.x),
+            r(s.max.y),
+            r(s.max.z)
+        );
         for &i in &ids {
             let x = sim.particles().x[i];
             let _ = writeln!(out, "  p{i}: {} {} {}", r(x.x), r(x.y), r(x.z));

@@ -17,9 +17,15 @@ fn public_worlds_read_with_their_headers() {
     let w = world("rotate");
     assert_eq!(w.integrator, hooke_core::Integrator::Rk4);
     assert_eq!((w.dt, w.every), (0.001, 1));
-    assert_eq!((w.k_elastic, w.d_elastic, w.k_collision, w.d_collision), (500.0, 0.25, 1000.0, 0.25));
+    assert_eq!(
+        (w.k_elastic, w.d_elastic, w.k_collision, w.d_collision),
+        (500.0, 0.25, 1000.0, 0.25)
+    );
     assert_eq!(w.plane, Some([1.0, -1.0, -1.0, 4.0]));
-    assert_eq!((w.resolution, w.field.len(), w.positions.len()), (30, 27000, 512));
+    assert_eq!(
+        (w.resolution, w.field.len(), w.positions.len()),
+        (30, 27000, 512)
+    );
     assert_eq!(world("moveLeft").plane, None);
 }
 
@@ -27,17 +33,32 @@ fn public_worlds_read_with_their_headers() {
 fn worlds_write_and_read_back_identical() {
     for name in WORLDS {
         let w = world(name);
-        assert_eq!(parse_world(&w.to_text(), Path::new("again.w")).unwrap(), w, "{name}");
+        assert_eq!(
+            parse_world(&w.to_text(), Path::new("again.w")).unwrap(),
+            w,
+            "{name}"
+        );
         let scene = w.to_scene(name);
-        assert_eq!(World::from_scene(&scene).unwrap(), w, "{name} through a scene");
+        assert_eq!(
+            World::from_scene(&scene).unwrap(),
+            w,
+            "{name} through a scene"
+        );
         let toml = hooke_scene::to_toml(&scene);
-        assert_eq!(hooke_scene::parse_scene(&toml, "w.toml").unwrap(), scene, "{name} through TOML text");
+        assert_eq!(
+            hooke_scene::parse_scene(&toml, "w.toml").unwrap(),
+            scene,
+            "{name} through TOML text"
+        );
     }
 }
 
 #[test]
 fn a_world_has_the_course_springs_and_rest_lengths() {
-    let scene = world("skewedCorner").to_scene("skewedCorner").build(Path::new(".")).unwrap();
+    let scene = world("skewedCorner")
+        .to_scene("skewedCorner")
+        .build(Path::new("."))
+        .unwrap();
     let springs = &scene.simulation.model().springs;
     assert_eq!(springs.len(), 6220);
     // Rest lengths come from the undeformed cube, not the skewed start.
@@ -59,7 +80,9 @@ fn public_world_trajectories() {
 }
 
 fn error(text: &str) -> String {
-    parse_world(text, Path::new("bad.w")).unwrap_err().to_string()
+    parse_world(text, Path::new("bad.w"))
+        .unwrap_err()
+        .to_string()
 }
 
 fn valid_text() -> String {
@@ -76,24 +99,64 @@ fn with_line(n: usize, line: &str) -> String {
 #[test]
 fn bad_worlds_are_refused_with_line_and_expectation() {
     let cases: Vec<(String, &str)> = vec![
-        (with_line(1, "Verlet"), "bad.w:1: expected the integrator RK4 or Euler, found 'Verlet'"),
-        (with_line(2, "-0.001 1"), "bad.w:2: expected the step size dt > 0, found -0.001"),
-        (with_line(2, "0.001 0"), "bad.w:2: expected the frame cadence n >= 1, found 0"),
-        (with_line(3, "500 0.25 abc 0.25"), "bad.w:3: expected kCollision (a number), found 'abc'"),
-        (with_line(4, "0"), "bad.w:4: expected the point mass > 0, found 0"),
-        (with_line(4, "nan"), "bad.w:4: expected the point mass as a finite number, found 'nan'"),
-        (with_line(5, "2"), "bad.w:5: expected the inclined-plane flag (0 or 1) from 0 to 1, found 2"),
-        (with_line(6, "-3"), "bad.w:6: expected the force-field resolution r from 0 to 400, found -3"),
-        (with_line(7, "0 inf 0"), "bad.w:7: expected y of force-field vector 0 of 27000 as a finite number, found 'inf'"),
-        (valid_text() + "extra\n", "bad.w:28031: expected the end of the file after 512 velocities, found 'extra'"),
+        (
+            with_line(1, "Verlet"),
+            "bad.w:1: expected the integrator RK4 or Euler, found 'Verlet'",
+        ),
+        (
+            with_line(2, "-0.001 1"),
+            "bad.w:2: expected the step size dt > 0, found -0.001",
+        ),
+        (
+            with_line(2, "0.001 0"),
+            "bad.w:2: expected the frame cadence n >= 1, found 0",
+        ),
+        (
+            with_line(3, "500 0.25 abc 0.25"),
+            "bad.w:3: expected kCollision (a number), found 'abc'",
+        ),
+        (
+            with_line(4, "0"),
+            "bad.w:4: expected the point mass > 0, found 0",
+        ),
+        (
+            with_line(4, "nan"),
+            "bad.w:4: expected the point mass as a finite number, found 'nan'",
+        ),
+        (
+            with_line(5, "2"),
+            "bad.w:5: expected the inclined-plane flag (0 or 1) from 0 to 1, found 2",
+        ),
+        (
+            with_line(6, "-3"),
+            "bad.w:6: expected the force-field resolution r from 0 to 400, found -3",
+        ),
+        (
+            with_line(7, "0 inf 0"),
+            "bad.w:7: expected y of force-field vector 0 of 27000 as a finite number, found 'inf'",
+        ),
+        (
+            valid_text() + "extra\n",
+            "bad.w:28031: expected the end of the file after 512 velocities, found 'extra'",
+        ),
     ];
     for (text, expected) in cases {
         assert_eq!(error(&text), expected);
     }
-    let truncated: String = valid_text().lines().take(27500).collect::<Vec<_>>().join("\n");
+    let truncated: String = valid_text()
+        .lines()
+        .take(27500)
+        .collect::<Vec<_>>()
+        .join("\n");
     let e = error(&truncated);
-    assert!(e.starts_with("bad.w:27500: unexpected end of file: expected x of position"), "{e}");
+    assert!(
+        e.starts_with("bad.w:27500: unexpected end of file: expected x of position"),
+        "{e}"
+    );
     // The course's reader takes any case and any white space.
     let relaxed = valid_text().replacen("RK4\n", "rk4 ", 1);
-    assert_eq!(parse_world(&relaxed, Path::new("ok.w")).unwrap(), world("moveLeft"));
+    assert_eq!(
+        parse_world(&relaxed, Path::new("ok.w")).unwrap(),
+        world("moveLeft")
+    );
 }

@@ -54,13 +54,13 @@ struct SetupArgs {
     #[arg(long)]
     integrator: Option<Integrator>,
     /// Step size in seconds.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     dt: Option<f64>,
     /// Run this many steps.
     #[arg(long, conflicts_with = "duration")]
     steps: Option<u64>,
     /// Run this many seconds of simulated time.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     duration: Option<f64>,
     /// A frame every K steps.
     #[arg(long, value_name = "K")]

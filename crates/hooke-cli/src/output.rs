@@ -17,13 +17,20 @@ pub struct AtomicFile {
 impl AtomicFile {
     /// Starts writing `target`.
     pub fn create(target: &Path) -> Result<Self> {
-        let name = target.file_name().with_context(|| format!("{} is not a file path", target.display()))?;
+        let name = target
+            .file_name()
+            .with_context(|| format!("{} is not a file path", target.display()))?;
         let mut temp_name = std::ffi::OsString::from(".");
         temp_name.push(name);
         temp_name.push(format!(".{}.tmp", std::process::id()));
         let temp = target.with_file_name(temp_name);
-        let file = File::create(&temp).with_context(|| format!("cannot create {}", temp.display()))?;
-        Ok(Self { target: target.to_path_buf(), temp, writer: Some(BufWriter::new(file)) })
+        let file =
+            File::create(&temp).with_context(|| format!("cannot create {}", temp.display()))?;
+        Ok(Self {
+            target: target.to_path_buf(),
+            temp,
+            writer: Some(BufWriter::new(file)),
+        })
     }
 
     /// The writer.
@@ -34,9 +41,14 @@ impl AtomicFile {
     /// Flushes, syncs and renames the file into place.
     pub fn commit(mut self) -> Result<()> {
         let writer = self.writer.take().expect("commit once");
-        let file = writer.into_inner().map_err(|e| e.into_error()).with_context(|| format!("cannot write {}", self.temp.display()))?;
-        file.sync_all().with_context(|| format!("cannot write {}", self.temp.display()))?;
-        std::fs::rename(&self.temp, &self.target).with_context(|| format!("cannot move {} into place", self.target.display()))
+        let file = writer
+            .into_inner()
+            .map_err(|e| e.into_error())
+            .with_context(|| format!("cannot write {}", self.temp.display()))?;
+        file.sync_all()
+            .with_context(|| format!("cannot write {}", self.temp.display()))?;
+        std::fs::rename(&self.temp, &self.target)
+            .with_context(|| format!("cannot move {} into place", self.target.display()))
     }
 }
 
@@ -51,6 +63,8 @@ impl Drop for AtomicFile {
 /// Writes a whole file atomically.
 pub fn write_atomic(target: &Path, bytes: &[u8]) -> Result<()> {
     let mut f = AtomicFile::create(target)?;
-    f.writer().write_all(bytes).with_context(|| format!("cannot write {}", target.display()))?;
+    f.writer()
+        .write_all(bytes)
+        .with_context(|| format!("cannot write {}", target.display()))?;
     f.commit()
 }

@@ -13,14 +13,19 @@ use std::process::ExitCode;
 
 /// Steps `scene` to its end, calling `on_frame(frame, simulation)` at frame 0 and after every
 /// `every` steps. A divergence comes back as an error holding a [`Divergence`].
-pub fn drive(scene: &mut Scene, mut on_frame: impl FnMut(u64, &Simulation) -> Result<()>) -> Result<()> {
+pub fn drive(
+    scene: &mut Scene,
+    mut on_frame: impl FnMut(u64, &Simulation) -> Result<()>,
+) -> Result<()> {
     let (steps, every) = (scene.steps, scene.every);
     let progress = if std::io::stderr().is_terminal() && steps >= 10_000 {
         let bar = ProgressBar::new(steps);
         bar.set_style(
-            ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} steps, {elapsed} elapsed, eta {eta}")
-                .expect("valid template")
-                .progress_chars("=> "),
+            ProgressStyle::with_template(
+                "{prefix} [{bar:40}] {pos}/{len} steps, {elapsed} elapsed, eta {eta}",
+            )
+            .expect("valid template")
+            .progress_chars("=> "),
         );
         bar.set_prefix(scene.spec.name.clone());
         bar
@@ -63,13 +68,24 @@ fn warn_if_unstable(scene: &Scene) -> StabilityEstimate {
 pub fn run(args: &RunArgs) -> Result<ExitCode> {
     let mut scene = source::build(&args.scene, &args.setup.overrides())?;
     warn_if_unstable(&scene);
-    let mut trajectory = args.trajectory.as_deref().map(TrajectoryWriter::create).transpose()?;
+    let mut trajectory = args
+        .trajectory
+        .as_deref()
+        .map(TrajectoryWriter::create)
+        .transpose()?;
     let every = scene.every;
     let dt = scene.simulation.dt();
     if args.summary {
         println!(
             "{:>6} {:>10} {:>13} {:>13} {:>26} {:>26} {:>10} {:>11}",
-            "frame", "time", "kinetic", "potential", "bbox min", "bbox max", "max speed", "max depth"
+            "frame",
+            "time",
+            "kinetic",
+            "potential",
+            "bbox min",
+            "bbox max",
+            "max speed",
+            "max depth"
         );
     }
     let result = drive(&mut scene, |frame, sim| {
@@ -112,7 +128,11 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         sim.model().springs.len()
     );
     if let Some(path) = &args.trajectory {
-        eprintln!("trajectory: {} ({} frames)", path.display(), scene.steps / every + 1);
+        eprintln!(
+            "trajectory: {} ({} frames)",
+            path.display(),
+            scene.steps / every + 1
+        );
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -121,35 +141,62 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
     let scene = source::build(arg, &setup.overrides())?;
     let sim = &scene.simulation;
     let estimate = warn_if_unstable(&scene);
-    println!("scene {}: {} particles, {} springs", scene.spec.name, sim.particles().len(), sim.model().springs.len());
-    println!("highest angular frequency ω_max ≈ {:.4e} rad/s (power iteration on M⁻¹K)", estimate.omega_max);
+    println!(
+        "scene {}: {} particles, {} springs",
+        scene.spec.name,
+        sim.particles().len(),
+        sim.model().springs.len()
+    );
+    println!(
+        "highest angular frequency ω_max ≈ {:.4e} rad/s (power iteration on M⁻¹K)",
+        estimate.omega_max
+    );
     println!("scene step: dt = {} s with {}", sim.dt(), sim.integrator());
     for integrator in Integrator::ALL {
         let limit = estimate.max_dt(integrator);
-        let mark = if integrator == sim.integrator() { "  <- scene" } else { "" };
+        let mark = if integrator == sim.integrator() {
+            "  <- scene"
+        } else {
+            ""
+        };
         let note = match integrator {
-            Integrator::Euler | Integrator::Midpoint => " (needs damping: amplifies undamped oscillation at any dt)",
+            Integrator::Euler | Integrator::Midpoint => {
+                " (needs damping: amplifies undamped oscillation at any dt)"
+            }
             _ => "",
         };
-        println!("  {:<11} stable for dt < {limit:.3e} s{note}{mark}", integrator.name());
+        println!(
+            "  {:<11} stable for dt < {limit:.3e} s{note}{mark}",
+            integrator.name()
+        );
     }
     Ok(ExitCode::SUCCESS)
 }
 
 pub fn convert(input: &Path, output: &Path) -> Result<ExitCode> {
-    let ext = |p: &Path| p.extension().and_then(|e| e.to_str()).unwrap_or("").to_string();
+    let ext = |p: &Path| {
+        p.extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_string()
+    };
     let text = match (ext(input).as_str(), ext(output).as_str()) {
         ("w", "toml") => {
             let world = hooke_scene::world::load_world(input)?;
-            let name = input.file_stem().map_or("world".into(), |s| s.to_string_lossy().into_owned());
+            let name = input
+                .file_stem()
+                .map_or("world".into(), |s| s.to_string_lossy().into_owned());
             hooke_scene::to_toml(&world.to_scene(&name))
         }
         ("toml", "w") => {
             let spec = hooke_scene::load_scene(input)?;
-            let world = hooke_scene::world::World::from_scene(&spec).with_context(|| format!("{} cannot be saved as a jello world", input.display()))?;
+            let world = hooke_scene::world::World::from_scene(&spec)
+                .with_context(|| format!("{} cannot be saved as a jello world", input.display()))?;
             world.to_text()
         }
-        (a, b) => bail!("cannot convert .{a} to .{b}: expected a .w world and a .toml scene, one each way"),
+        (a, b) => bail!(
+            "cannot convert .{a} to .{b}: expected a .w world and a .toml scene, one each way"
+        ),
     };
     crate::output::write_atomic(output, text.as_bytes())?;
     eprintln!("wrote {}", output.display());

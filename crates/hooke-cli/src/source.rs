@@ -20,26 +20,41 @@ pub fn read(arg: &str) -> Result<Source> {
     if !is_file {
         let spec = hooke_scene::builtin::builtin(arg).with_context(|| {
             let names: Vec<&str> = BUILTINS.iter().map(|b| b.0).collect();
-            format!("no built-in scene '{arg}' and no such file; built-in scenes: {}", names.join(", "))
+            format!(
+                "no built-in scene '{arg}' and no such file; built-in scenes: {}",
+                names.join(", ")
+            )
         })?;
-        return Ok(Source { spec, base: PathBuf::from(".") });
+        return Ok(Source {
+            spec,
+            base: PathBuf::from("."),
+        });
     }
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let spec = match path.extension().and_then(|e| e.to_str()) {
         Some("w") => hooke_scene::world::load_world(path)?.to_scene(&stem(path)),
         Some("toml") => hooke_scene::load_scene(path)?,
-        _ => bail!("{}: expected a scene file ending in .toml or a jello world ending in .w", path.display()),
+        _ => bail!(
+            "{}: expected a scene file ending in .toml or a jello world ending in .w",
+            path.display()
+        ),
     };
     Ok(Source { spec, base })
 }
 
 fn stem(path: &Path) -> String {
-    path.file_stem().map_or_else(|| "world".into(), |s| s.to_string_lossy().into_owned())
+    path.file_stem()
+        .map_or_else(|| "world".into(), |s| s.to_string_lossy().into_owned())
 }
 
 /// Reads and builds the scene named by `arg` with command-line overrides.
 pub fn build(arg: &str, overrides: &Overrides) -> Result<Scene> {
     let mut source = read(arg)?;
-    overrides.apply(&mut source.spec).with_context(|| format!("scene '{arg}'"))?;
-    source.spec.build(&source.base).with_context(|| format!("scene '{arg}'"))
+    overrides
+        .apply(&mut source.spec)
+        .with_context(|| format!("scene '{arg}'"))?;
+    source
+        .spec
+        .build(&source.base)
+        .with_context(|| format!("scene '{arg}'"))
 }

@@ -20,16 +20,24 @@ impl TrajectoryWriter {
     /// Starts a trajectory file (in place only when finished).
     pub fn create(path: &Path) -> Result<Self> {
         let mut file = AtomicFile::create(path)?;
-        writeln!(file.writer(), "{HEADER}").with_context(|| format!("cannot write {}", path.display()))?;
-        Ok(Self { file, path: path.to_path_buf() })
+        writeln!(file.writer(), "{HEADER}")
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(Self {
+            file,
+            path: path.to_path_buf(),
+        })
     }
 
     /// Appends one frame.
     pub fn frame(&mut self, frame: u64, time: f64, p: &Particles) -> Result<()> {
         let w = self.file.writer();
         for (i, (x, v)) in p.x.iter().zip(&p.v).enumerate() {
-            writeln!(w, "{frame},{time},{i},{},{},{},{},{},{}", x.x, x.y, x.z, v.x, v.y, v.z)
-                .with_context(|| format!("cannot write {}", self.path.display()))?;
+            writeln!(
+                w,
+                "{frame},{time},{i},{},{},{},{},{},{}",
+                x.x, x.y, x.z, v.x, v.y, v.z
+            )
+            .with_context(|| format!("cannot write {}", self.path.display()))?;
         }
         Ok(())
     }

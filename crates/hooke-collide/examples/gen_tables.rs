@@ -3,7 +3,11 @@
 use std::path::PathBuf;
 
 fn main() -> std::io::Result<()> {
-    let dir = PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| "assets/meshes".into()));
+    let dir = PathBuf::from(
+        std::env::args()
+            .nth(1)
+            .unwrap_or_else(|| "assets/meshes".into()),
+    );
     std::fs::create_dir_all(&dir)?;
     for (name, text) in [
         ("table.obj", hooke_collide::table::round_table_obj()),

@@ -26,7 +26,10 @@ pub struct BoxInterior {
 impl BoxInterior {
     /// The jello course's box `[-2, 2]^3`.
     pub fn jello() -> Self {
-        Self { min: Vec3::repeat(-2.0), max: Vec3::repeat(2.0) }
+        Self {
+            min: Vec3::repeat(-2.0),
+            max: Vec3::repeat(2.0),
+        }
     }
 }
 
@@ -42,12 +45,20 @@ impl Collider for BoxInterior {
                 normal[axis] = 1.0;
                 let mut point = *p;
                 point[axis] = self.min[axis];
-                sink(Contact { depth: self.min[axis] - p[axis], normal, point });
+                sink(Contact {
+                    depth: self.min[axis] - p[axis],
+                    normal,
+                    point,
+                });
             } else if p[axis] > self.max[axis] {
                 normal[axis] = -1.0;
                 let mut point = *p;
                 point[axis] = self.max[axis];
-                sink(Contact { depth: p[axis] - self.max[axis], normal, point });
+                sink(Contact {
+                    depth: p[axis] - self.max[axis],
+                    normal,
+                    point,
+                });
             }
         }
     }

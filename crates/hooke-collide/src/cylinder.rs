@@ -47,14 +47,30 @@ impl Collider for Cylinder {
         let to_side = self.radius - r;
         let contact = if to_top <= to_side && to_top <= to_bottom {
             let n = Vec3::new(0.0, 1.0, 0.0);
-            Contact { depth: to_top, normal: n, point: Vec3::new(p.x, top, p.z) }
+            Contact {
+                depth: to_top,
+                normal: n,
+                point: Vec3::new(p.x, top, p.z),
+            }
         } else if to_side <= to_bottom && r > 0.0 {
             let n = Vec3::new(dx / r, 0.0, dz / r);
-            let point = Vec3::new(self.center.x + n.x * self.radius, p.y, self.center.z + n.z * self.radius);
-            Contact { depth: to_side, normal: n, point }
+            let point = Vec3::new(
+                self.center.x + n.x * self.radius,
+                p.y,
+                self.center.z + n.z * self.radius,
+            );
+            Contact {
+                depth: to_side,
+                normal: n,
+                point,
+            }
         } else {
             let n = Vec3::new(0.0, -1.0, 0.0);
-            Contact { depth: to_bottom, normal: n, point: Vec3::new(p.x, bottom, p.z) }
+            Contact {
+                depth: to_bottom,
+                normal: n,
+                point: Vec3::new(p.x, bottom, p.z),
+            }
         };
         sink(contact);
     }

@@ -47,7 +47,11 @@ pub fn load_mesh(path: &Path, placement: &Placement) -> Result<TriMeshCollider, 
 }
 
 /// [`load_mesh`] on OBJ text already in memory; `name` is used in messages.
-pub fn load_mesh_str(text: &str, name: &str, placement: &Placement) -> Result<TriMeshCollider, MeshError> {
+pub fn load_mesh_str(
+    text: &str,
+    name: &str,
+    placement: &Placement,
+) -> Result<TriMeshCollider, MeshError> {
     let path = Path::new(name);
     let parts = parse_obj(text, path, placement)?;
     TriMeshCollider::new(format!("mesh {name}"), parts, path, false)

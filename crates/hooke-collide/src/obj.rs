@@ -31,7 +31,11 @@ pub struct Placement {
 
 impl Default for Placement {
     fn default() -> Self {
-        Self { translate: Vec3::zeros(), rotate: Vec3::zeros(), scale: Vec3::repeat(1.0) }
+        Self {
+            translate: Vec3::zeros(),
+            rotate: Vec3::zeros(),
+            scale: Vec3::repeat(1.0),
+        }
     }
 }
 
@@ -74,7 +78,9 @@ pub enum MeshError {
         text: String,
     },
     /// The file holds no triangle.
-    #[error("{path}: the mesh has no triangles (expected at least one 'f' line with 3 or more vertices)")]
+    #[error(
+        "{path}: the mesh has no triangles (expected at least one 'f' line with 3 or more vertices)"
+    )]
     Empty {
         /// The file.
         path: PathBuf,
@@ -106,23 +112,46 @@ pub enum MeshError {
 
 /// Reads an OBJ file and places it.
 pub fn load_obj(path: &Path, placement: &Placement) -> Result<Vec<MeshPart>, MeshError> {
-    let text = std::fs::read_to_string(path).map_err(|source| MeshError::Io { path: path.to_path_buf(), source })?;
+    let text = std::fs::read_to_string(path).map_err(|source| MeshError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
     parse_obj(&text, path, placement)
 }
 
 /// Parses OBJ text (`path` only names it in errors) and places it.
-pub fn parse_obj(text: &str, path: &Path, placement: &Placement) -> Result<Vec<MeshPart>, MeshError> {
+pub fn parse_obj(
+    text: &str,
+    path: &Path,
+    placement: &Placement,
+) -> Result<Vec<MeshPart>, MeshError> {
     // tobj parses NaN happily and reports no lines, so finiteness is checked here, with one.
     for (n, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
-        if words.next() == Some("v") && words.take(3).any(|w| w.parse::<f64>().is_ok_and(|x| !x.is_finite())) {
-            return Err(MeshError::NonFinite { path: path.to_path_buf(), line: n + 1, text: line.trim().to_string() });
+        if words.next() == Some("v")
+            && words
+                .take(3)
+                .any(|w| w.parse::<f64>().is_ok_and(|x| !x.is_finite()))
+        {
+            return Err(MeshError::NonFinite {
+                path: path.to_path_buf(),
+                line: n + 1,
+                text: line.trim().to_string(),
+            });
         }
     }
-    let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
     let (models, _materials) =
-        tobj::load_obj_buf(&mut Cursor::new(text), &options, |_| Ok(Default::default()))
-            .map_err(|e| MeshError::Obj { path: path.to_path_buf(), reason: e.to_string() })?;
+        tobj::load_obj_buf(&mut Cursor::new(text), &options, |_| Ok(Default::default())).map_err(
+            |e| MeshError::Obj {
+                path: path.to_path_buf(),
+                reason: e.to_string(),
+            },
+        )?;
     let parts: Vec<MeshPart> = models
         .into_iter()
         .filter(|m| !m.mesh.indices.is_empty())
@@ -134,11 +163,18 @@ pub fn parse_obj(text: &str, path: &Path, placement: &Placement) -> Result<Vec<M
                 .chunks_exact(3)
                 .map(|c| placement.apply(&Vec3::new(c[0], c[1], c[2])))
                 .collect(),
-            triangles: m.mesh.indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+            triangles: m
+                .mesh
+                .indices
+                .chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect(),
         })
         .collect();
     if parts.is_empty() {
-        return Err(MeshError::Empty { path: path.to_path_buf() });
+        return Err(MeshError::Empty {
+            path: path.to_path_buf(),
+        });
     }
     Ok(parts)
 }

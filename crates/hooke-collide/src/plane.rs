@@ -27,7 +27,11 @@ pub struct Plane {
 impl Plane {
     /// The ground `y = height`, solid below (free side up).
     pub fn ground(height: f64) -> Self {
-        Self { coefficients: [0.0, 1.0, 0.0, -height], side: 1.0, label: "ground" }
+        Self {
+            coefficients: [0.0, 1.0, 0.0, -height],
+            side: 1.0,
+            label: "ground",
+        }
     }
 
     /// The plane `a x + b y + c z + d = 0` whose free side is the one holding `free_point`
@@ -38,7 +42,11 @@ impl Plane {
         if !coefficients.iter().all(|x| x.is_finite()) || (a == 0.0 && b == 0.0 && c == 0.0) {
             return None;
         }
-        let probe = Self { coefficients, side: 1.0, label: "inclined plane" };
+        let probe = Self {
+            coefficients,
+            side: 1.0,
+            label: "inclined plane",
+        };
         let side = if probe.f(free_point) < 0.0 { -1.0 } else { 1.0 };
         Some(Self { side, ..probe })
     }
@@ -76,7 +84,11 @@ impl Collider for Plane {
             let norm = self.norm();
             let depth = -sf / norm;
             let normal = Vec3::new(a, b, c) * self.side / norm;
-            sink(Contact { depth, normal, point: p + normal * depth });
+            sink(Contact {
+                depth,
+                normal,
+                point: p + normal * depth,
+            });
         }
     }
 }

@@ -70,10 +70,14 @@ pub fn closedness_defect(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Option<St
     sorted.sort();
     for (&(a, b), &count) in sorted {
         if count > 1 {
-            return Some(format!("edge {a}-{b} is used {count} times in the same direction"));
+            return Some(format!(
+                "edge {a}-{b} is used {count} times in the same direction"
+            ));
         }
         if !edges.contains_key(&(b, a)) {
-            return Some(format!("edge {a}-{b} has no opposite: the surface has a hole"));
+            return Some(format!(
+                "edge {a}-{b} has no opposite: the surface has a hole"
+            ));
         }
     }
     None
@@ -81,37 +85,56 @@ pub fn closedness_defect(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Option<St
 
 impl TriMeshCollider {
     /// Builds a collider from mesh parts. With `require_closed`, an open part is an error.
-    pub fn new(label: impl Into<String>, parts: Vec<MeshPart>, path: &Path, require_closed: bool) -> Result<Self, MeshError> {
+    pub fn new(
+        label: impl Into<String>,
+        parts: Vec<MeshPart>,
+        path: &Path,
+        require_closed: bool,
+    ) -> Result<Self, MeshError> {
         let label = label.into();
         let mut built = Vec::with_capacity(parts.len());
         for part in parts {
             let defect = closedness_defect(&part.vertices, &part.triangles);
             if let (true, Some(detail)) = (require_closed, &defect) {
-                return Err(MeshError::NotClosed { path: path.to_path_buf(), part: part.name, detail: detail.clone() });
+                return Err(MeshError::NotClosed {
+                    path: path.to_path_buf(),
+                    part: part.name,
+                    detail: detail.clone(),
+                });
             }
             let closed = defect.is_none();
             let count = part.vertices.len() as u32;
-            if let Some(t) = part.triangles.iter().find(|t| t.iter().any(|&i| i >= count)) {
+            if let Some(t) = part
+                .triangles
+                .iter()
+                .find(|t| t.iter().any(|&i| i >= count))
+            {
                 return Err(MeshError::Build {
                     path: path.to_path_buf(),
                     part: part.name,
                     reason: format!("triangle {t:?} names a vertex beyond the {count} it has"),
                 });
             }
-            let mut flags = TriMeshFlags::MERGE_DUPLICATE_VERTICES | TriMeshFlags::DELETE_DEGENERATE_TRIANGLES;
+            let mut flags =
+                TriMeshFlags::MERGE_DUPLICATE_VERTICES | TriMeshFlags::DELETE_DEGENERATE_TRIANGLES;
             if closed {
                 flags |= TriMeshFlags::ORIENTED;
             }
             let vertices = part.vertices.iter().map(to_parry).collect();
-            let mesh = ParryMesh::with_flags(vertices, part.triangles, flags).map_err(|e| MeshError::Build {
-                path: path.to_path_buf(),
-                part: part.name.clone(),
-                reason: e.to_string(),
+            let mesh = ParryMesh::with_flags(vertices, part.triangles, flags).map_err(|e| {
+                MeshError::Build {
+                    path: path.to_path_buf(),
+                    part: part.name.clone(),
+                    reason: e.to_string(),
+                }
             })?;
             let aabb = mesh.local_aabb();
             built.push(Part { mesh, closed, aabb });
         }
-        Ok(Self { label, parts: built })
+        Ok(Self {
+            label,
+            parts: built,
+        })
     }
 
     /// Number of parts (objects).
@@ -130,7 +153,10 @@ impl TriMeshCollider {
             .iter()
             .flat_map(|p| {
                 let v = p.mesh.vertices();
-                p.mesh.indices().iter().map(move |t| t.map(|i| from_parry(v[i as usize])))
+                p.mesh
+                    .indices()
+                    .iter()
+                    .map(move |t| t.map(|i| from_parry(v[i as usize])))
             })
             .collect()
     }
@@ -147,7 +173,11 @@ impl Collider for TriMeshCollider {
     }
 
     fn contacts(&self, p: &Vec3, sink: &mut dyn FnMut(Contact)) {
-        for part in self.parts.iter().filter(|part| part.closed && in_aabb(&part.aabb, p)) {
+        for part in self
+            .parts
+            .iter()
+            .filter(|part| part.closed && in_aabb(&part.aabb, p))
+        {
             let proj = part.mesh.project_local_point(to_parry(p), false);
             if !proj.is_inside {
                 continue;
@@ -156,7 +186,11 @@ impl Collider for TriMeshCollider {
             let offset = point - p;
             let depth = offset.norm();
             if depth > 0.0 {
-                sink(Contact { depth, normal: offset / depth, point });
+                sink(Contact {
+                    depth,
+                    normal: offset / depth,
+                    point,
+                });
             }
         }
     }
@@ -176,7 +210,9 @@ impl Collider for TriMeshCollider {
             if hi.x < a.x || lo.x > b.x || hi.y < a.y || lo.y > b.y || hi.z < a.z || lo.z > b.z {
                 continue;
             }
-            let Some(hit) = part.mesh.cast_local_ray_and_get_normal(&ray, 1.0, false) else { continue };
+            let Some(hit) = part.mesh.cast_local_ray_and_get_normal(&ray, 1.0, false) else {
+                continue;
+            };
             let normal = from_parry(hit.normal);
             let entering = normal.dot(&dir) < 0.0;
             // A closed part's normals point out, so only entering counts; an open sheet is
@@ -191,7 +227,11 @@ impl Collider for TriMeshCollider {
         }
         best.map(|(t, normal)| {
             let point = from + dir * t + normal * CROSSING_STANDOFF;
-            Contact { depth: (point - to).dot(&normal), normal, point }
+            Contact {
+                depth: (point - to).dot(&normal),
+                normal,
+                point,
+            }
         })
     }
 }

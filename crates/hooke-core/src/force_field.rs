@@ -25,7 +25,9 @@ impl ForceField {
     /// A field of resolution `r` with `r³` values in file order; `None` if the count is wrong
     /// or `r` is zero (a zero-resolution world simply has no field).
     pub fn new(resolution: usize, values: Vec<Vec3>) -> Option<Self> {
-        let expected = resolution.checked_mul(resolution)?.checked_mul(resolution)?;
+        let expected = resolution
+            .checked_mul(resolution)?
+            .checked_mul(resolution)?;
         (resolution > 0 && values.len() == expected).then_some(Self { resolution, values })
     }
 
@@ -57,7 +59,9 @@ impl ForceField {
         let (a, tx) = axis(p.x);
         let (b, ty) = axis(p.y);
         let (c, tz) = axis(p.z);
-        let at = |da: usize, db: usize, dc: usize| self.values[(a + da) * r * r + (b + db) * r + (c + dc)];
+        let at = |da: usize, db: usize, dc: usize| {
+            self.values[(a + da) * r * r + (b + db) * r + (c + dc)]
+        };
         let lerp = |u: Vec3, w: Vec3, t: f64| u * (1.0 - t) + w * t;
         let x00 = lerp(at(0, 0, 0), at(1, 0, 0), tx);
         let x10 = lerp(at(0, 1, 0), at(1, 1, 0), tx);

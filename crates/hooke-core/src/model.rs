@@ -180,12 +180,17 @@ impl Model {
             .iter()
             .map(|s| s.energy(&x[s.i as usize], &x[s.j as usize]))
             .sum();
-        let gravity: f64 = x.iter().zip(mass).map(|(x, m)| -m * self.gravity.dot(x)).sum();
+        let gravity: f64 = x
+            .iter()
+            .zip(mass)
+            .map(|(x, m)| -m * self.gravity.dot(x))
+            .sum();
         let mut penalty = 0.0;
         for slot in &self.colliders {
             if let Response::Penalty { kc, .. } = slot.response {
                 for p in x {
-                    slot.shape.contacts(p, &mut |c| penalty += 0.5 * kc * c.depth * c.depth);
+                    slot.shape
+                        .contacts(p, &mut |c| penalty += 0.5 * kc * c.depth * c.depth);
                 }
             }
         }

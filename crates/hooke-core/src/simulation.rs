@@ -62,7 +62,14 @@ impl Simulation {
                 particles.v[i] = Vec3::zeros();
             }
         }
-        Self { particles, model, integrator, dt, step: 0, workspace: Workspace::default() }
+        Self {
+            particles,
+            model,
+            integrator,
+            dt,
+            step: 0,
+            workspace: Workspace::default(),
+        }
     }
 
     /// The current particles.
@@ -98,9 +105,15 @@ impl Simulation {
     /// Advances one step: the integrator, then the velocity-level collision responses, then
     /// the divergence check.
     pub fn step(&mut self) -> Result<(), Divergence> {
-        self.integrator.step(&self.model, &mut self.particles, self.dt, &mut self.workspace);
+        self.integrator.step(
+            &self.model,
+            &mut self.particles,
+            self.dt,
+            &mut self.workspace,
+        );
         let p = &mut self.particles;
-        self.model.resolve_contacts(&p.inv_mass, &self.workspace.x0, &mut p.x, &mut p.v);
+        self.model
+            .resolve_contacts(&p.inv_mass, &self.workspace.x0, &mut p.x, &mut p.v);
         self.step += 1;
         self.check()
     }

@@ -41,7 +41,11 @@ impl StabilityEstimate {
         let mut u: Vec<Vec3> = (0..n)
             .map(|i| {
                 let t = i as f64;
-                Vec3::new((t * 0.7548).sin() + 1.1, (t * 0.5698).cos() + 1.3, (t * 0.3141).sin() + 1.7)
+                Vec3::new(
+                    (t * 0.7548).sin() + 1.1,
+                    (t * 0.5698).cos() + 1.3,
+                    (t * 0.3141).sin() + 1.7,
+                )
             })
             .collect();
         let mut w = vec![Vec3::zeros(); n];
@@ -54,7 +58,9 @@ impl StabilityEstimate {
         }
         // The Rayleigh quotient converges from below; the last growth factor bounds the error.
         let growth = dot(&u, &u).sqrt();
-        Self { omega_max: lambda.max(growth).max(0.0).sqrt() }
+        Self {
+            omega_max: lambda.max(growth).max(0.0).sqrt(),
+        }
     }
 
     /// The largest stable step of `integrator` in seconds, or `None` where the scheme has no

@@ -4,7 +4,8 @@ use crate::generators::Lattice;
 use crate::spec::*;
 use hooke_collide::{BoxInterior, Cylinder, MeshError, Placement, Plane, TriMeshCollider};
 use hooke_core::{
-    ColliderSlot, Collider, ForceField, Model, Particles, Response, Simulation, Spring, SpringKind, Vec3,
+    Collider, ColliderSlot, ForceField, Model, Particles, Response, Simulation, Spring, SpringKind,
+    Vec3,
 };
 use nalgebra::Rotation3;
 use std::ops::Range;
@@ -16,8 +17,14 @@ pub const MAX_PARTICLES: usize = 20_000_000;
 
 /// Meshes shipped inside Hooke, addressable as `builtin:NAME` from any scene file.
 pub const BUILTIN_MESHES: [(&str, &str); 2] = [
-    ("table.obj", include_str!("../../../assets/meshes/table.obj")),
-    ("square-table.obj", include_str!("../../../assets/meshes/square-table.obj")),
+    (
+        "table.obj",
+        include_str!("../../../assets/meshes/table.obj"),
+    ),
+    (
+        "square-table.obj",
+        include_str!("../../../assets/meshes/square-table.obj"),
+    ),
 ];
 
 /// Why a scene description cannot be simulated.
@@ -42,7 +49,10 @@ pub enum BuildError {
 }
 
 fn invalid(key: impl Into<String>, message: impl Into<String>) -> BuildError {
-    BuildError::Invalid { key: key.into(), message: message.into() }
+    BuildError::Invalid {
+        key: key.into(),
+        message: message.into(),
+    }
 }
 
 /// How a body's particles are arranged, for drawing surfaces and picking subsets.
@@ -143,11 +153,18 @@ impl Overrides {
         if let Some(table) = &self.table {
             let mut replaced = false;
             for c in &mut spec.colliders {
-                if matches!(c.shape, ColliderShapeSpec::Mesh { .. } | ColliderShapeSpec::Cylinder { .. }) {
+                if matches!(
+                    c.shape,
+                    ColliderShapeSpec::Mesh { .. } | ColliderShapeSpec::Cylinder { .. }
+                ) {
                     c.shape = if table == "cylinder" {
                         let r = hooke_collide::table::round::TOP_RADIUS;
                         ColliderShapeSpec::Cylinder {
-                            center: [Finite(0.0), Finite(hooke_collide::table::round::TOP_Y), Finite(0.0)],
+                            center: [
+                                Finite(0.0),
+                                Finite(hooke_collide::table::round::TOP_Y),
+                                Finite(0.0),
+                            ],
                             radius: Positive(r),
                             thickness: Positive(hooke_collide::table::round::TOP_THICKNESS),
                         }
@@ -163,7 +180,13 @@ impl Overrides {
                 }
             }
             if !replaced {
-                return Err(invalid("--table", format!("scene '{}' has no table (mesh or cylinder collider) to replace", spec.name)));
+                return Err(invalid(
+                    "--table",
+                    format!(
+                        "scene '{}' has no table (mesh or cylinder collider) to replace",
+                        spec.name
+                    ),
+                ));
             }
         }
         Ok(())
@@ -184,14 +207,26 @@ impl SceneSpec {
     pub fn total_steps(&self) -> Result<u64, BuildError> {
         let sim = &self.simulation;
         match (sim.steps, sim.duration) {
-            (Some(_), Some(_)) => Err(invalid("simulation", "give `steps` or `duration`, not both")),
-            (None, None) => Err(invalid("simulation", "expected `steps` or `duration` (the length of the run)")),
+            (Some(_), Some(_)) => Err(invalid(
+                "simulation",
+                "give `steps` or `duration`, not both",
+            )),
+            (None, None) => Err(invalid(
+                "simulation",
+                "expected `steps` or `duration` (the length of the run)",
+            )),
             (Some(0), None) => Err(invalid("simulation.steps", "expected at least 1 step")),
             (Some(n), None) => Ok(n),
             (None, Some(t)) => {
                 let n = (t.0 / sim.dt.0).round();
                 if n < 1.0 || n > 1e15 {
-                    Err(invalid("simulation.duration", format!("{} s at dt = {} s is {n} steps; expected 1 to 1e15", t.0, sim.dt.0)))
+                    Err(invalid(
+                        "simulation.duration",
+                        format!(
+                            "{} s at dt = {} s is {n} steps; expected 1 to 1e15",
+                            t.0, sim.dt.0
+                        ),
+                    ))
                 } else {
                     Ok(n as u64)
                 }
@@ -205,7 +240,10 @@ impl SceneSpec {
         let steps = self.total_steps()?;
         let every = self.simulation.every;
         if every == 0 {
-            return Err(invalid("simulation.every", "expected a frame cadence of at least 1 step"));
+            return Err(invalid(
+                "simulation.every",
+                "expected a frame cadence of at least 1 step",
+            ));
         }
         let mut particles = Particles::default();
         let mut springs = Vec::new();
@@ -215,7 +253,10 @@ impl SceneSpec {
             let built = build_body(body, &key, particles.len())?;
             let start = particles.len();
             if start + built.local.len() > MAX_PARTICLES {
-                return Err(invalid(&key, format!("the scene would have more than {MAX_PARTICLES} particles")));
+                return Err(invalid(
+                    &key,
+                    format!("the scene would have more than {MAX_PARTICLES} particles"),
+                ));
             }
             let r = rotation(&body.rotate);
             let o = vec3(&body.origin);
@@ -223,31 +264,60 @@ impl SceneSpec {
             if let Some(ps) = &body.positions
                 && ps.len() != n
             {
-                return Err(invalid(format!("{key}.positions"), format!("expected {n} positions (one per particle), found {}", ps.len())));
+                return Err(invalid(
+                    format!("{key}.positions"),
+                    format!(
+                        "expected {n} positions (one per particle), found {}",
+                        ps.len()
+                    ),
+                ));
             }
             if let Some(vs) = &body.velocities
                 && vs.len() != n
             {
-                return Err(invalid(format!("{key}.velocities"), format!("expected {n} velocities (one per particle), found {}", vs.len())));
+                return Err(invalid(
+                    format!("{key}.velocities"),
+                    format!(
+                        "expected {n} velocities (one per particle), found {}",
+                        vs.len()
+                    ),
+                ));
             }
             for (p, local) in built.local.iter().enumerate() {
                 let x = match &body.positions {
                     Some(ps) => vec3(&ps[p]),
                     None => o + r * local,
                 };
-                let v = body.velocities.as_ref().map_or(vec3(&body.velocity), |vs| vec3(&vs[p]));
+                let v = body
+                    .velocities
+                    .as_ref()
+                    .map_or(vec3(&body.velocity), |vs| vec3(&vs[p]));
                 particles.push(x, v, body.mass.0);
             }
             for (k, &pin) in body.pins.iter().enumerate() {
                 if pin >= n {
-                    return Err(invalid(format!("{key}.pins[{k}]"), format!("particle {pin} does not exist; the body has {n} (0 to {})", n - 1)));
+                    return Err(invalid(
+                        format!("{key}.pins[{k}]"),
+                        format!(
+                            "particle {pin} does not exist; the body has {n} (0 to {})",
+                            n - 1
+                        ),
+                    ));
                 }
                 particles.pin(start + pin);
             }
             springs.extend(built.springs);
-            bodies.push(Body { name: body.name.clone(), range: start..start + n, topology: built.topology });
+            bodies.push(Body {
+                name: body.name.clone(),
+                range: start..start + n,
+                topology: built.topology,
+            });
         }
-        let centroid = if particles.is_empty() { Vec3::zeros() } else { particles.centroid() };
+        let centroid = if particles.is_empty() {
+            Vec3::zeros()
+        } else {
+            particles.centroid()
+        };
         let mut slots = Vec::new();
         let mut geometry = Vec::new();
         for (c, spec) in self.colliders.iter().enumerate() {
@@ -255,7 +325,10 @@ impl SceneSpec {
             let (shape, geo) = build_collider(&spec.shape, &key, base, &centroid)?;
             let response = match spec.response {
                 ResponseSpec::Penalty { kc, dc } => Response::Penalty { kc: kc.0, dc: dc.0 },
-                ResponseSpec::Restitution { cr, friction } => Response::Restitution { cr: cr.0, friction: friction.0 },
+                ResponseSpec::Restitution { cr, friction } => Response::Restitution {
+                    cr: cr.0,
+                    friction: friction.0,
+                },
                 ResponseSpec::Stick => Response::Stick,
             };
             slots.push(ColliderSlot { shape, response });
@@ -268,7 +341,13 @@ impl SceneSpec {
                 let values = f.values.iter().map(vec3).collect::<Vec<_>>();
                 let found = values.len();
                 Some(ForceField::new(f.resolution, values).ok_or_else(|| {
-                    invalid("force_field.values", format!("expected resolution³ = {} vectors, found {found}", f.resolution.saturating_pow(3)))
+                    invalid(
+                        "force_field.values",
+                        format!(
+                            "expected resolution³ = {} vectors, found {found}",
+                            f.resolution.saturating_pow(3)
+                        ),
+                    )
                 })?)
             }
         };
@@ -280,8 +359,20 @@ impl SceneSpec {
             colliders: slots,
             ..Model::default()
         };
-        let simulation = Simulation::new(particles, model, self.simulation.integrator.0, self.simulation.dt.0);
-        Ok(Scene { spec: self.clone(), simulation, steps, every, bodies, colliders: geometry })
+        let simulation = Simulation::new(
+            particles,
+            model,
+            self.simulation.integrator.0,
+            self.simulation.dt.0,
+        );
+        Ok(Scene {
+            spec: self.clone(),
+            simulation,
+            steps,
+            every,
+            bodies,
+            colliders: geometry,
+        })
     }
 }
 
@@ -293,22 +384,57 @@ struct BuiltBody {
 
 fn build_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, BuildError> {
     let (lattice, h, topology) = match &body.shape {
-        ShapeSpec::Chain { count, spacing } => (Lattice { size: [*count, 1, 1] }, spacing.0, Topology::Chain),
-        ShapeSpec::Grid { size, spacing } => (Lattice { size: [size[0], 1, size[1]] }, spacing.0, Topology::Grid(*size)),
-        ShapeSpec::Lattice { size, spacing } => (Lattice { size: *size }, spacing.0, Topology::Lattice(*size)),
+        ShapeSpec::Chain { count, spacing } => (
+            Lattice {
+                size: [*count, 1, 1],
+            },
+            spacing.0,
+            Topology::Chain,
+        ),
+        ShapeSpec::Grid { size, spacing } => (
+            Lattice {
+                size: [size[0], 1, size[1]],
+            },
+            spacing.0,
+            Topology::Grid(*size),
+        ),
+        ShapeSpec::Lattice { size, spacing } => {
+            (Lattice { size: *size }, spacing.0, Topology::Lattice(*size))
+        }
         ShapeSpec::Points { positions } => {
             let local: Vec<Vec3> = positions.iter().map(vec3).collect();
-            if body.springs.structural.is_some() || body.springs.shear.is_some() || body.springs.bend.is_some() {
-                return Err(invalid(format!("{key}.springs"), "points have no topology: use explicit `pairs`, not structural/shear/bend"));
+            if body.springs.structural.is_some()
+                || body.springs.shear.is_some()
+                || body.springs.bend.is_some()
+            {
+                return Err(invalid(
+                    format!("{key}.springs"),
+                    "points have no topology: use explicit `pairs`, not structural/shear/bend",
+                ));
             }
             let springs = pairs(body, key, &local, offset)?;
-            return Ok(BuiltBody { local, springs, topology: Topology::Points });
+            return Ok(BuiltBody {
+                local,
+                springs,
+                topology: Topology::Points,
+            });
         }
     };
-    let count = lattice.size.iter().try_fold(1usize, |acc, &n| acc.checked_mul(n));
+    let count = lattice
+        .size
+        .iter()
+        .try_fold(1usize, |acc, &n| acc.checked_mul(n));
     match count {
         Some(n) if (1..=MAX_PARTICLES).contains(&n) => {}
-        _ => return Err(invalid(format!("{key}.shape.size"), format!("expected 1 to {MAX_PARTICLES} particles, found size {:?}", lattice.size))),
+        _ => {
+            return Err(invalid(
+                format!("{key}.shape.size"),
+                format!(
+                    "expected 1 to {MAX_PARTICLES} particles, found size {:?}",
+                    lattice.size
+                ),
+            ));
+        }
     }
     let local = lattice.positions(h);
     let mut springs = Vec::new();
@@ -325,10 +451,19 @@ fn build_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, Bu
         }
     }
     springs.extend(pairs(body, key, &local, offset)?);
-    Ok(BuiltBody { local, springs, topology })
+    Ok(BuiltBody {
+        local,
+        springs,
+        topology,
+    })
 }
 
-fn pairs(body: &BodySpec, key: &str, local: &[Vec3], offset: usize) -> Result<Vec<Spring>, BuildError> {
+fn pairs(
+    body: &BodySpec,
+    key: &str,
+    local: &[Vec3],
+    offset: usize,
+) -> Result<Vec<Spring>, BuildError> {
     let n = local.len();
     body.springs
         .pairs
@@ -338,11 +473,23 @@ fn pairs(body: &BodySpec, key: &str, local: &[Vec3], offset: usize) -> Result<Ve
             if p.i >= n || p.j >= n || p.i == p.j {
                 return Err(invalid(
                     format!("{key}.springs.pairs[{k}]"),
-                    format!("expected two different particles below {n}, found i = {}, j = {}", p.i, p.j),
+                    format!(
+                        "expected two different particles below {n}, found i = {}, j = {}",
+                        p.i, p.j
+                    ),
                 ));
             }
-            let rest = p.rest.map_or_else(|| (local[p.i] - local[p.j]).norm(), |r| r.0);
-            Ok(Spring { i: (offset + p.i) as u32, j: (offset + p.j) as u32, rest, ks: p.ks.0, kd: p.kd.0, kind: SpringKind::Other })
+            let rest = p
+                .rest
+                .map_or_else(|| (local[p.i] - local[p.j]).norm(), |r| r.0);
+            Ok(Spring {
+                i: (offset + p.i) as u32,
+                j: (offset + p.j) as u32,
+                rest,
+                ks: p.ks.0,
+                kd: p.kd.0,
+                kind: SpringKind::Other,
+            })
         })
         .collect()
 }
@@ -356,13 +503,19 @@ fn mesh_text(path: &str, base: &Path) -> Result<(String, PathBuf), MeshError> {
                 path: PathBuf::from(path),
                 source: std::io::Error::new(
                     std::io::ErrorKind::NotFound,
-                    format!("no built-in mesh '{name}'; built-in meshes: {}", BUILTIN_MESHES.map(|m| m.0).join(", ")),
+                    format!(
+                        "no built-in mesh '{name}'; built-in meshes: {}",
+                        BUILTIN_MESHES.map(|m| m.0).join(", ")
+                    ),
                 ),
             }),
         };
     }
     let full = base.join(path);
-    let text = std::fs::read_to_string(&full).map_err(|source| MeshError::Io { path: full.clone(), source })?;
+    let text = std::fs::read_to_string(&full).map_err(|source| MeshError::Io {
+        path: full.clone(),
+        source,
+    })?;
     Ok((text, full))
 }
 
@@ -373,31 +526,65 @@ fn build_collider(
     centroid: &Vec3,
 ) -> Result<(Box<dyn Collider>, ColliderGeometry), BuildError> {
     Ok(match shape {
-        ColliderShapeSpec::Ground { height } => (Box::new(Plane::ground(height.0)), ColliderGeometry::Ground(height.0)),
+        ColliderShapeSpec::Ground { height } => (
+            Box::new(Plane::ground(height.0)),
+            ColliderGeometry::Ground(height.0),
+        ),
         ColliderShapeSpec::Plane { coefficients } => {
             let c = coefficients.map(|x| x.0);
-            let plane = Plane::inclined(c, centroid).ok_or_else(|| invalid(format!("{key}.shape.coefficients"), "expected a plane: (a, b, c) must not be all zero"))?;
+            let plane = Plane::inclined(c, centroid).ok_or_else(|| {
+                invalid(
+                    format!("{key}.shape.coefficients"),
+                    "expected a plane: (a, b, c) must not be all zero",
+                )
+            })?;
             (Box::new(plane), ColliderGeometry::Plane(c))
         }
         ColliderShapeSpec::Box { min, max } => {
-            let b = BoxInterior { min: vec3(min), max: vec3(max) };
+            let b = BoxInterior {
+                min: vec3(min),
+                max: vec3(max),
+            };
             if (0..3).any(|d| b.min[d] >= b.max[d]) {
-                return Err(invalid(format!("{key}.shape"), "expected min < max on every axis"));
+                return Err(invalid(
+                    format!("{key}.shape"),
+                    "expected min < max on every axis",
+                ));
             }
             (Box::new(b), ColliderGeometry::Box(b))
         }
-        ColliderShapeSpec::Cylinder { center, radius, thickness } => {
-            let c = Cylinder { center: vec3(center), radius: radius.0, thickness: thickness.0 };
+        ColliderShapeSpec::Cylinder {
+            center,
+            radius,
+            thickness,
+        } => {
+            let c = Cylinder {
+                center: vec3(center),
+                radius: radius.0,
+                thickness: thickness.0,
+            };
             (Box::new(c), ColliderGeometry::Cylinder(c))
         }
-        ColliderShapeSpec::Mesh { path, translate, rotate, scale } => {
-            let placement = Placement { translate: vec3(translate), rotate: vec3(rotate), scale: Vec3::new(scale[0].0, scale[1].0, scale[2].0) };
+        ColliderShapeSpec::Mesh {
+            path,
+            translate,
+            rotate,
+            scale,
+        } => {
+            let placement = Placement {
+                translate: vec3(translate),
+                rotate: vec3(rotate),
+                scale: Vec3::new(scale[0].0, scale[1].0, scale[2].0),
+            };
             let mesh = || -> Result<TriMeshCollider, MeshError> {
                 let (text, full) = mesh_text(path, base)?;
                 let parts = hooke_collide::parse_obj(&text, &full, &placement)?;
                 TriMeshCollider::new(format!("mesh {path}"), parts, &full, false)
             };
-            let mesh = mesh().map_err(|source| BuildError::Mesh { key: format!("{key}.shape.path"), source })?;
+            let mesh = mesh().map_err(|source| BuildError::Mesh {
+                key: format!("{key}.shape.path"),
+                source,
+            })?;
             let tris = mesh.triangles();
             (Box::new(mesh), ColliderGeometry::Mesh(tris))
         }

@@ -13,7 +13,10 @@ fn f3(v: [f64; 3]) -> [Finite; 3] {
 }
 
 fn params(ks: f64, kd: f64) -> Option<SpringParams> {
-    Some(SpringParams { ks: NonNegative(ks), kd: NonNegative(kd) })
+    Some(SpringParams {
+        ks: NonNegative(ks),
+        kd: NonNegative(kd),
+    })
 }
 
 fn sim(integrator: Integrator, dt: f64, duration: f64, every: u64, drag: f64) -> SimulationSpec {
@@ -28,7 +31,13 @@ fn sim(integrator: Integrator, dt: f64, duration: f64, every: u64, drag: f64) ->
     }
 }
 
-fn body(name: &str, mass: f64, origin: [f64; 3], shape: ShapeSpec, springs: SpringsSpec) -> BodySpec {
+fn body(
+    name: &str,
+    mass: f64,
+    origin: [f64; 3],
+    shape: ShapeSpec,
+    springs: SpringsSpec,
+) -> BodySpec {
     BodySpec {
         name: name.into(),
         mass: Positive(mass),
@@ -45,8 +54,13 @@ fn body(name: &str, mass: f64, origin: [f64; 3], shape: ShapeSpec, springs: Spri
 
 fn ground(cr: f64, friction: f64) -> ColliderSpec {
     ColliderSpec {
-        shape: ColliderShapeSpec::Ground { height: Finite(0.0) },
-        response: ResponseSpec::Restitution { cr: Fraction(cr), friction: Fraction(friction) },
+        shape: ColliderShapeSpec::Ground {
+            height: Finite(0.0),
+        },
+        response: ResponseSpec::Restitution {
+            cr: Fraction(cr),
+            friction: Fraction(friction),
+        },
     }
 }
 
@@ -63,7 +77,9 @@ pub fn single_spring() -> SceneSpec {
         "mass",
         1.0,
         [0.0, 2.0, 0.0],
-        ShapeSpec::Points { positions: vec![f3([0.0, 0.0, 0.0]), f3([0.0, -1.5, 0.0])] },
+        ShapeSpec::Points {
+            positions: vec![f3([0.0, 0.0, 0.0]), f3([0.0, -1.5, 0.0])],
+        },
         SpringsSpec::default(),
     );
     b.pins = vec![0];
@@ -98,13 +114,21 @@ pub fn chain() -> SceneSpec {
         "chain",
         CHAIN_MASS,
         [0.0, 2.2, 0.0],
-        ShapeSpec::Chain { count: CHAIN_COUNT, spacing: Positive(0.15) },
-        SpringsSpec { structural: params(CHAIN_KS, 0.2), ..SpringsSpec::default() },
+        ShapeSpec::Chain {
+            count: CHAIN_COUNT,
+            spacing: Positive(0.15),
+        },
+        SpringsSpec {
+            structural: params(CHAIN_KS, 0.2),
+            ..SpringsSpec::default()
+        },
     );
     b.pins = vec![0];
     SceneSpec {
         name: "chain".into(),
-        description: "a chain pendulum of 12 masses released horizontal; swings and comes to hang straight".into(),
+        description:
+            "a chain pendulum of 12 masses released horizontal; swings and comes to hang straight"
+                .into(),
         simulation: sim(Integrator::Symplectic, 2e-4, 12.0, 100, 0.03),
         bodies: vec![b],
         colliders: vec![ground(0.3, 0.2)],
@@ -119,13 +143,23 @@ pub fn jello_cube() -> SceneSpec {
         "jelly",
         1.0 / 512.0,
         [-0.15, 0.9, -0.25],
-        ShapeSpec::Lattice { size: [8, 8, 8], spacing: Positive(0.5 / 7.0) },
-        SpringsSpec { structural: params(300.0, 0.3), shear: params(300.0, 0.3), bend: params(150.0, 0.3), pairs: Vec::new() },
+        ShapeSpec::Lattice {
+            size: [8, 8, 8],
+            spacing: Positive(0.5 / 7.0),
+        },
+        SpringsSpec {
+            structural: params(300.0, 0.3),
+            shear: params(300.0, 0.3),
+            bend: params(150.0, 0.3),
+            pairs: Vec::new(),
+        },
     );
     b.rotate = f3([30.0, 20.0, 35.0]);
     SceneSpec {
         name: "jello-cube".into(),
-        description: "an 8x8x8 jelly cube dropped tilted onto the ground; bounces, settles, keeps its shape".into(),
+        description:
+            "an 8x8x8 jelly cube dropped tilted onto the ground; bounces, settles, keeps its shape"
+                .into(),
         simulation: sim(Integrator::Symplectic, 2.5e-4, 3.0, 40, 0.0),
         bodies: vec![b],
         colliders: vec![ground(0.5, 0.3)],
@@ -141,13 +175,23 @@ pub fn hanging_cloth() -> SceneSpec {
         "cloth",
         0.5 / (n * n) as f64,
         [-0.5, 2.0, -0.5],
-        ShapeSpec::Grid { size: [n, n], spacing: Positive(1.0 / (n - 1) as f64) },
-        SpringsSpec { structural: params(400.0, 0.02), shear: params(200.0, 0.02), bend: params(20.0, 0.005), pairs: Vec::new() },
+        ShapeSpec::Grid {
+            size: [n, n],
+            spacing: Positive(1.0 / (n - 1) as f64),
+        },
+        SpringsSpec {
+            structural: params(400.0, 0.02),
+            shear: params(200.0, 0.02),
+            bend: params(20.0, 0.005),
+            pairs: Vec::new(),
+        },
     );
     b.pins = vec![0, n - 1];
     SceneSpec {
         name: "hanging-cloth".into(),
-        description: "a 25x25 cloth pinned at two corners, released flat; swings and settles into a drape".into(),
+        description:
+            "a 25x25 cloth pinned at two corners, released flat; swings and settles into a drape"
+                .into(),
         simulation: sim(Integrator::Symplectic, 2.5e-4, 6.0, 40, 0.002),
         bodies: vec![b],
         colliders: vec![ground(0.2, 0.5)],
@@ -164,12 +208,22 @@ pub fn cloth_table() -> SceneSpec {
         "cloth",
         0.4 / (n * n) as f64,
         [-side / 2.0, 1.3, -side / 2.0],
-        ShapeSpec::Grid { size: [n, n], spacing: Positive(side / (n - 1) as f64) },
-        SpringsSpec { structural: params(300.0, 0.02), shear: params(150.0, 0.02), bend: params(15.0, 0.005), pairs: Vec::new() },
+        ShapeSpec::Grid {
+            size: [n, n],
+            spacing: Positive(side / (n - 1) as f64),
+        },
+        SpringsSpec {
+            structural: params(300.0, 0.02),
+            shear: params(150.0, 0.02),
+            bend: params(15.0, 0.005),
+            pairs: Vec::new(),
+        },
     );
     SceneSpec {
         name: "cloth-table".into(),
-        description: "a 32x32 cloth dropped onto a round table; the middle sticks to the top, the edges hang".into(),
+        description:
+            "a 32x32 cloth dropped onto a round table; the middle sticks to the top, the edges hang"
+                .into(),
         simulation: sim(Integrator::Symplectic, 2.5e-4, 3.0, 40, 0.002),
         bodies: vec![b],
         colliders: vec![

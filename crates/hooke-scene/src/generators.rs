@@ -93,7 +93,12 @@ impl Lattice {
                     for k in 0..self.size[2] - span[2] {
                         let p = self.index([i + a[0], j + a[1], k + a[2]]) as u32;
                         let q = self.index([i + b[0], j + b[1], k + b[2]]) as u32;
-                        out.push(Edge { i: p, j: q, rest, kind });
+                        out.push(Edge {
+                            i: p,
+                            j: q,
+                            rest,
+                            kind,
+                        });
                     }
                 }
             }

@@ -22,7 +22,9 @@ pub mod generators;
 pub mod spec;
 pub mod world;
 
-pub use build::{BUILTIN_MESHES, Body, BuildError, ColliderGeometry, MAX_PARTICLES, Overrides, Scene, Topology};
+pub use build::{
+    BUILTIN_MESHES, Body, BuildError, ColliderGeometry, MAX_PARTICLES, Overrides, Scene, Topology,
+};
 pub use spec::SceneSpec;
 
 use std::path::{Path, PathBuf};
@@ -51,17 +53,26 @@ pub enum SceneError {
 
 /// Parses scene text; `name` names it in errors.
 pub fn parse_scene(text: &str, name: impl AsRef<Path>) -> Result<SceneSpec, SceneError> {
-    toml::from_str(text).map_err(|e| SceneError::Syntax { path: name.as_ref().to_path_buf(), message: e.to_string().trim_end().to_string() })
+    toml::from_str(text).map_err(|e| SceneError::Syntax {
+        path: name.as_ref().to_path_buf(),
+        message: e.to_string().trim_end().to_string(),
+    })
 }
 
 /// Reads a scene file.
 pub fn load_scene(path: &Path) -> Result<SceneSpec, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
     parse_scene(&text, path)
 }
 
 /// The scene as TOML text, with a header naming it; [`parse_scene`] reads it back equal.
 pub fn to_toml(spec: &SceneSpec) -> String {
     let body = toml::to_string(spec).expect("scene specs always serialise");
-    format!("# Hooke scene '{}': {}\n# Format: see crates/hooke-scene/src/spec.rs and the README.\n\n{body}", spec.name, spec.description)
+    format!(
+        "# Hooke scene '{}': {}\n# Format: see crates/hooke-scene/src/spec.rs and the README.\n\n{body}",
+        spec.name, spec.description
+    )
 }

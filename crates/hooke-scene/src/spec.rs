@@ -16,7 +16,11 @@ pub struct Finite(pub f64);
 impl TryFrom<f64> for Finite {
     type Error = String;
     fn try_from(x: f64) -> Result<Self, String> {
-        if x.is_finite() { Ok(Self(x)) } else { Err(format!("expected a finite number, found {x}")) }
+        if x.is_finite() {
+            Ok(Self(x))
+        } else {
+            Err(format!("expected a finite number, found {x}"))
+        }
     }
 }
 
@@ -34,7 +38,11 @@ pub struct Positive(pub f64);
 impl TryFrom<f64> for Positive {
     type Error = String;
     fn try_from(x: f64) -> Result<Self, String> {
-        if x.is_finite() && x > 0.0 { Ok(Self(x)) } else { Err(format!("expected a finite number > 0, found {x}")) }
+        if x.is_finite() && x > 0.0 {
+            Ok(Self(x))
+        } else {
+            Err(format!("expected a finite number > 0, found {x}"))
+        }
     }
 }
 
@@ -52,7 +60,11 @@ pub struct NonNegative(pub f64);
 impl TryFrom<f64> for NonNegative {
     type Error = String;
     fn try_from(x: f64) -> Result<Self, String> {
-        if x.is_finite() && x >= 0.0 { Ok(Self(x)) } else { Err(format!("expected a finite number >= 0, found {x}")) }
+        if x.is_finite() && x >= 0.0 {
+            Ok(Self(x))
+        } else {
+            Err(format!("expected a finite number >= 0, found {x}"))
+        }
     }
 }
 
@@ -70,7 +82,11 @@ pub struct Fraction(pub f64);
 impl TryFrom<f64> for Fraction {
     type Error = String;
     fn try_from(x: f64) -> Result<Self, String> {
-        if (0.0..=1.0).contains(&x) { Ok(Self(x)) } else { Err(format!("expected a number in [0, 1], found {x}")) }
+        if (0.0..=1.0).contains(&x) {
+            Ok(Self(x))
+        } else {
+            Err(format!("expected a number in [0, 1], found {x}"))
+        }
     }
 }
 
@@ -88,7 +104,9 @@ pub struct IntegratorName(pub Integrator);
 impl TryFrom<String> for IntegratorName {
     type Error = String;
     fn try_from(s: String) -> Result<Self, String> {
-        s.parse().map(Self).map_err(|e: hooke_core::UnknownIntegrator| e.to_string())
+        s.parse()
+            .map(Self)
+            .map_err(|e: hooke_core::UnknownIntegrator| e.to_string())
     }
 }
 

@@ -96,13 +96,25 @@ struct Tokens<'a> {
 
 impl<'a> Tokens<'a> {
     fn new(text: &'a str, path: &'a Path) -> Self {
-        let words: Vec<(usize, &str)> =
-            text.lines().enumerate().flat_map(|(n, line)| line.split_whitespace().map(move |w| (n + 1, w))).collect();
-        Self { path, words, next: 0, last_line: text.lines().count().max(1) }
+        let words: Vec<(usize, &str)> = text
+            .lines()
+            .enumerate()
+            .flat_map(|(n, line)| line.split_whitespace().map(move |w| (n + 1, w)))
+            .collect();
+        Self {
+            path,
+            words,
+            next: 0,
+            last_line: text.lines().count().max(1),
+        }
     }
 
     fn fail(&self, line: usize, message: String) -> WorldError {
-        WorldError::Format { path: self.path.to_path_buf(), line, message }
+        WorldError::Format {
+            path: self.path.to_path_buf(),
+            line,
+            message,
+        }
     }
 
     fn word(&mut self, what: &str) -> Result<(usize, &'a str), WorldError> {
@@ -111,7 +123,10 @@ impl<'a> Tokens<'a> {
                 self.next += 1;
                 Ok(w)
             }
-            None => Err(self.fail(self.last_line, format!("unexpected end of file: expected {what}"))),
+            None => Err(self.fail(
+                self.last_line,
+                format!("unexpected end of file: expected {what}"),
+            )),
         }
     }
 
@@ -119,15 +134,27 @@ impl<'a> Tokens<'a> {
         let (line, w) = self.word(what)?;
         match w.parse::<f64>() {
             Ok(x) if x.is_finite() => Ok(x),
-            Ok(_) => Err(self.fail(line, format!("expected {what} as a finite number, found '{w}'"))),
+            Ok(_) => Err(self.fail(
+                line,
+                format!("expected {what} as a finite number, found '{w}'"),
+            )),
             Err(_) => Err(self.fail(line, format!("expected {what} (a number), found '{w}'"))),
         }
     }
 
-    fn checked(&mut self, what: &str, ok: impl Fn(f64) -> bool, rule: &str) -> Result<f64, WorldError> {
+    fn checked(
+        &mut self,
+        what: &str,
+        ok: impl Fn(f64) -> bool,
+        rule: &str,
+    ) -> Result<f64, WorldError> {
         let line = self.words.get(self.next).map_or(self.last_line, |w| w.0);
         let x = self.number(what)?;
-        if ok(x) { Ok(x) } else { Err(self.fail(line, format!("expected {what} {rule}, found {x}"))) }
+        if ok(x) {
+            Ok(x)
+        } else {
+            Err(self.fail(line, format!("expected {what} {rule}, found {x}")))
+        }
     }
 
     fn integer(&mut self, what: &str, max: u64) -> Result<u64, WorldError> {
@@ -135,7 +162,10 @@ impl<'a> Tokens<'a> {
         match w.parse::<i64>() {
             Ok(n) if n >= 0 && n as u64 <= max => Ok(n as u64),
             Ok(n) => Err(self.fail(line, format!("expected {what} from 0 to {max}, found {n}"))),
-            Err(_) => Err(self.fail(line, format!("expected {what} (a whole number), found '{w}'"))),
+            Err(_) => Err(self.fail(
+                line,
+                format!("expected {what} (a whole number), found '{w}'"),
+            )),
         }
     }
 
@@ -155,7 +185,10 @@ impl<'a> Tokens<'a> {
 
 /// Reads a `.w` file.
 pub fn load_world(path: &Path) -> Result<World, WorldError> {
-    let text = std::fs::read_to_string(path).map_err(|source| WorldError::Io { path: path.to_path_buf(), source })?;
+    let text = std::fs::read_to_string(path).map_err(|source| WorldError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
     parse_world(&text, path)
 }
 
@@ -166,12 +199,20 @@ pub fn parse_world(text: &str, path: &Path) -> Result<World, WorldError> {
     let integrator = match name.to_ascii_lowercase().as_str() {
         "rk4" => Integrator::Rk4,
         "euler" => Integrator::Euler,
-        _ => return Err(t.fail(line, format!("expected the integrator RK4 or Euler, found '{name}'"))),
+        _ => {
+            return Err(t.fail(
+                line,
+                format!("expected the integrator RK4 or Euler, found '{name}'"),
+            ));
+        }
     };
     let dt = t.checked("the step size dt", |x| x > 0.0, "> 0")?;
     let every = t.integer("the frame cadence n", u32::MAX as u64)?;
     if every == 0 {
-        return Err(t.fail(t.words[t.next - 1].0, "expected the frame cadence n >= 1, found 0".into()));
+        return Err(t.fail(
+            t.words[t.next - 1].0,
+            "expected the frame cadence n >= 1, found 0".into(),
+        ));
     }
     let non_negative = |x: f64| x >= 0.0;
     let k_elastic = t.checked("kElastic", non_negative, ">= 0")?;
@@ -181,9 +222,17 @@ pub fn parse_world(text: &str, path: &Path) -> Result<World, WorldError> {
     let mass = t.checked("the point mass", |x| x > 0.0, "> 0")?;
     let plane = match t.integer("the inclined-plane flag (0 or 1)", 1)? {
         1 => {
-            let c = [t.number("plane a")?, t.number("plane b")?, t.number("plane c")?, t.number("plane d")?];
+            let c = [
+                t.number("plane a")?,
+                t.number("plane b")?,
+                t.number("plane c")?,
+                t.number("plane d")?,
+            ];
             if c[..3].iter().all(|x| *x == 0.0) {
-                return Err(t.fail(t.words[t.next - 1].0, "expected a plane: a, b and c are all zero".into()));
+                return Err(t.fail(
+                    t.words[t.next - 1].0,
+                    "expected a plane: a, b and c are all zero".into(),
+                ));
             }
             Some(c)
         }
@@ -194,9 +243,26 @@ pub fn parse_world(text: &str, path: &Path) -> Result<World, WorldError> {
     let positions = t.vectors(POINTS, "position")?;
     let velocities = t.vectors(POINTS, "velocity")?;
     if let Some(&(line, w)) = t.words.get(t.next) {
-        return Err(t.fail(line, format!("expected the end of the file after 512 velocities, found '{w}'")));
+        return Err(t.fail(
+            line,
+            format!("expected the end of the file after 512 velocities, found '{w}'"),
+        ));
     }
-    Ok(World { integrator, dt, every, k_elastic, d_elastic, k_collision, d_collision, mass, plane, resolution, field, positions, velocities })
+    Ok(World {
+        integrator,
+        dt,
+        every,
+        k_elastic,
+        d_elastic,
+        k_collision,
+        d_collision,
+        mass,
+        plane,
+        resolution,
+        field,
+        positions,
+        velocities,
+    })
 }
 
 /// Why a scene cannot be saved as a jello world.
@@ -212,10 +278,18 @@ impl World {
     /// The world as `.w` text.
     pub fn to_text(&self) -> String {
         let mut s = String::new();
-        let name = if self.integrator == Integrator::Rk4 { "RK4" } else { "Euler" };
+        let name = if self.integrator == Integrator::Rk4 {
+            "RK4"
+        } else {
+            "Euler"
+        };
         let _ = writeln!(s, "{name}");
         let _ = writeln!(s, "{} {}", self.dt, self.every);
-        let _ = writeln!(s, "{} {} {} {}", self.k_elastic, self.d_elastic, self.k_collision, self.d_collision);
+        let _ = writeln!(
+            s,
+            "{} {} {} {}",
+            self.k_elastic, self.d_elastic, self.k_collision, self.d_collision
+        );
         let _ = writeln!(s, "{}", self.mass);
         match self.plane {
             Some([a, b, c, d]) => {
@@ -224,7 +298,12 @@ impl World {
             None => s.push_str("0\n"),
         }
         let _ = writeln!(s, "{}", self.resolution);
-        for v in self.field.iter().chain(&self.positions).chain(&self.velocities) {
+        for v in self
+            .field
+            .iter()
+            .chain(&self.positions)
+            .chain(&self.velocities)
+        {
             let _ = writeln!(s, "{} {} {}", v.x, v.y, v.z);
         }
         s
@@ -234,14 +313,28 @@ impl World {
     /// from the undeformed cube, the box and the plane as penalty colliders, the force field,
     /// no gravity.
     pub fn to_scene(&self, name: &str) -> SceneSpec {
-        let springs = Some(SpringParams { ks: NonNegative(self.k_elastic), kd: NonNegative(self.d_elastic) });
-        let penalty = ResponseSpec::Penalty { kc: NonNegative(self.k_collision), dc: NonNegative(self.d_collision) };
+        let springs = Some(SpringParams {
+            ks: NonNegative(self.k_elastic),
+            kd: NonNegative(self.d_elastic),
+        });
+        let penalty = ResponseSpec::Penalty {
+            kc: NonNegative(self.k_collision),
+            dc: NonNegative(self.d_collision),
+        };
         let mut colliders = vec![ColliderSpec {
-            shape: ColliderShapeSpec::Box { min: [Finite(-2.0); 3], max: [Finite(2.0); 3] },
+            shape: ColliderShapeSpec::Box {
+                min: [Finite(-2.0); 3],
+                max: [Finite(2.0); 3],
+            },
             response: penalty,
         }];
         if let Some(c) = self.plane {
-            colliders.push(ColliderSpec { shape: ColliderShapeSpec::Plane { coefficients: c.map(Finite) }, response: penalty });
+            colliders.push(ColliderSpec {
+                shape: ColliderShapeSpec::Plane {
+                    coefficients: c.map(Finite),
+                },
+                response: penalty,
+            });
         }
         SceneSpec {
             name: name.to_string(),
@@ -264,12 +357,22 @@ impl World {
                 pins: Vec::new(),
                 positions: Some(self.positions.iter().map(finite3).collect()),
                 velocities: Some(self.velocities.iter().map(finite3).collect()),
-                shape: ShapeSpec::Lattice { size: [SIDE; 3], spacing: Positive(SPACING) },
-                springs: SpringsSpec { structural: springs, shear: springs, bend: springs, pairs: Vec::new() },
+                shape: ShapeSpec::Lattice {
+                    size: [SIDE; 3],
+                    spacing: Positive(SPACING),
+                },
+                springs: SpringsSpec {
+                    structural: springs,
+                    shear: springs,
+                    bend: springs,
+                    pairs: Vec::new(),
+                },
             }],
             colliders,
-            force_field: (self.resolution > 0)
-                .then(|| ForceFieldSpec { resolution: self.resolution, values: self.field.iter().map(finite3).collect() }),
+            force_field: (self.resolution > 0).then(|| ForceFieldSpec {
+                resolution: self.resolution,
+                values: self.field.iter().map(finite3).collect(),
+            }),
         }
     }
 
@@ -286,13 +389,25 @@ impl World {
         if sim.gravity.iter().any(|g| g.0 != 0.0) || sim.drag.0 != 0.0 {
             return no("jello worlds have no gravity and no drag (use the force field)");
         }
-        let [body] = spec.bodies.as_slice() else { return no("a jello world has exactly one body") };
-        if body.shape != (ShapeSpec::Lattice { size: [SIDE; 3], spacing: Positive(SPACING) }) {
+        let [body] = spec.bodies.as_slice() else {
+            return no("a jello world has exactly one body");
+        };
+        if body.shape
+            != (ShapeSpec::Lattice {
+                size: [SIDE; 3],
+                spacing: Positive(SPACING),
+            })
+        {
             return no("the body must be an 8x8x8 lattice of spacing 1/7");
         }
         let s = &body.springs;
-        let (Some(p), true) = (s.structural, s.shear == s.structural && s.bend == s.structural && s.pairs.is_empty()) else {
-            return no("structural, shear and bend springs must all be present with the same ks and kd, and no explicit pairs");
+        let (Some(p), true) = (
+            s.structural,
+            s.shear == s.structural && s.bend == s.structural && s.pairs.is_empty(),
+        ) else {
+            return no(
+                "structural, shear and bend springs must all be present with the same ks and kd, and no explicit pairs",
+            );
         };
         if !body.pins.is_empty() {
             return no("jello worlds have no pinned points");
@@ -301,16 +416,24 @@ impl World {
         let mut has_box = false;
         let mut plane = None;
         for c in &spec.colliders {
-            let ResponseSpec::Penalty { kc, dc } = c.response else { return no("jello colliders are penalty springs") };
+            let ResponseSpec::Penalty { kc, dc } = c.response else {
+                return no("jello colliders are penalty springs");
+            };
             if penalty.is_some_and(|p| p != (kc.0, dc.0)) {
                 return no("all colliders must share kCollision and dCollision");
             }
             penalty = Some((kc.0, dc.0));
             match &c.shape {
-                ColliderShapeSpec::Box { min, max } if min.iter().all(|x| x.0 == -2.0) && max.iter().all(|x| x.0 == 2.0) && !has_box => {
+                ColliderShapeSpec::Box { min, max }
+                    if min.iter().all(|x| x.0 == -2.0)
+                        && max.iter().all(|x| x.0 == 2.0)
+                        && !has_box =>
+                {
                     has_box = true
                 }
-                ColliderShapeSpec::Plane { coefficients } if plane.is_none() => plane = Some(coefficients.map(|x| x.0)),
+                ColliderShapeSpec::Plane { coefficients } if plane.is_none() => {
+                    plane = Some(coefficients.map(|x| x.0))
+                }
                 _ => return no("colliders must be the [-2, 2]^3 box and at most one plane"),
             }
         }
@@ -324,7 +447,11 @@ impl World {
                 let r = body.rotate.map(|a| a.0.to_radians());
                 let rot = nalgebra::Rotation3::from_euler_angles(r[0], r[1], r[2]);
                 let lattice = crate::generators::Lattice { size: [SIDE; 3] };
-                lattice.positions(SPACING).iter().map(|p| v3(&body.origin) + rot * p).collect()
+                lattice
+                    .positions(SPACING)
+                    .iter()
+                    .map(|p| v3(&body.origin) + rot * p)
+                    .collect()
             }
         };
         let velocities = match &body.velocities {

@@ -10,7 +10,15 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
     ws.x0.copy_from_slice(&p.x);
     // Stage 1 at the current state; its position derivative is the velocity itself.
     ws.kx[0].copy_from_slice(&p.v);
-    accelerations(model, &ws.adjacency, p, &p.x, &p.v, &mut ws.spring_force, &mut ws.kv[0]);
+    accelerations(
+        model,
+        &ws.adjacency,
+        p,
+        &p.x,
+        &p.v,
+        &mut ws.spring_force,
+        &mut ws.kv[0],
+    );
     // Stages 2..4 at s + c·dt·k_{stage-1}, with c = 1/2, 1/2, 1.
     for (stage, c) in [(1, half), (2, half), (3, dt)] {
         for i in 0..n {
@@ -18,7 +26,15 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
             ws.vt[i] = p.v[i] + ws.kv[stage - 1][i] * c;
         }
         ws.kx[stage].copy_from_slice(&ws.vt);
-        accelerations(model, &ws.adjacency, p, &ws.xt, &ws.vt, &mut ws.spring_force, &mut ws.kv[stage]);
+        accelerations(
+            model,
+            &ws.adjacency,
+            p,
+            &ws.xt,
+            &ws.vt,
+            &mut ws.spring_force,
+            &mut ws.kv[stage],
+        );
     }
     let sixth = dt / 6.0;
     let [k1x, k2x, k3x, k4x] = &ws.kx;

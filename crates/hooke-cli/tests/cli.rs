@@ -1,0 +1,273 @@
+//! The `hooke` binary as a user runs it.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn hooke(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hooke"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .canonicalize()
+        .unwrap()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("hooke-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn every_builtin_runs_and_writes_a_spec_trajectory() {
+    let dir = scratch("builtins");
+    for (name, particles) in [
+        ("single-spring", 2),
+        ("chain", 12),
+        ("jello-cube", 512),
+        ("hanging-cloth", 625),
+        ("cloth-table", 1024),
+    ] {
+        let out = hooke(
+            &[
+                "run",
+                name,
+                "--steps",
+                "205",
+                "--every",
+                "50",
+                "--trajectory",
+                "t.csv",
+            ],
+            &dir,
+        );
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        let text = std::fs::read_to_string(dir.join("t.csv")).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(lines.next(), Some("frame,time,particle,x,y,z,vx,vy,vz"));
+        // Frames 0..=4 (steps 0, 50, ..., 200): the last multiple of 50 that 205 steps reach.
+        assert_eq!(lines.clone().count(), 5 * particles, "{name}");
+        let last: Vec<&str> = lines.last().unwrap().split(',').collect();
+        assert_eq!(last[0], "4");
+        let dt: f64 = match name {
+            "single-spring" => 1e-3,
+            "chain" => 2e-4,
+            _ => 2.5e-4,
+        };
+        assert_eq!(
+            last[1].parse::<f64>().unwrap(),
+            200.0 * dt,
+            "{name}: time is f·K·dt as one product"
+        );
+        assert_eq!(last[2], (particles - 1).to_string());
+    }
+}
+
+#[test]
+fn a_printed_scene_reproduces_the_builtin_run_bit_for_bit() {
+    let dir = scratch("roundtrip");
+    let printed = hooke(&["scene", "cloth-table"], &dir);
+    assert!(printed.status.success());
+    std::fs::write(dir.join("mine.toml"), &printed.stdout).unwrap();
+    for (scene, csv) in [("cloth-table", "a.csv"), ("mine.toml", "b.csv")] {
+        let out = hooke(
+            &[
+                "run",
+                scene,
+                "--steps",
+                "400",
+                "--every",
+                "100",
+                "--trajectory",
+                csv,
+            ],
+            &dir,
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    assert_eq!(
+        std::fs::read(dir.join("a.csv")).unwrap(),
+        std::fs::read(dir.join("b.csv")).unwrap()
+    );
+}
+
+#[test]
+fn public_worlds_run_from_the_command_line() {
+    let dir = scratch("worlds");
+    for name in ["jello", "gravity", "moveLeft", "rotate", "skewedCorner"] {
+        let world = root().join(format!("assets/worlds/{name}.w"));
+        let out = hooke(
+            &[
+                "run",
+                world.to_str().unwrap(),
+                "--steps",
+                "100",
+                "--every",
+                "50",
+                "--trajectory",
+                "t.csv",
+            ],
+            &dir,
+        );
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        let text = std::fs::read_to_string(dir.join("t.csv")).unwrap();
+        assert_eq!(text.lines().count(), 1 + 3 * 512, "{name}");
+    }
+}
+
+#[test]
+fn worlds_convert_to_scenes_and_back() {
+    let dir = scratch("convert");
+    let world = root().join("assets/worlds/rotate.w");
+    let out = hooke(&["convert", world.to_str().unwrap(), "rotate.toml"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = hooke(&["convert", "rotate.toml", "rotate.w"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for (input, csv) in [
+        (world.to_str().unwrap(), "a.csv"),
+        ("rotate.toml", "b.csv"),
+        ("rotate.w", "c.csv"),
+    ] {
+        let out = hooke(&["run", input, "--steps", "50", "--trajectory", csv], &dir);
+        assert!(out.status.success(), "{input}: {}", stderr(&out));
+    }
+    let a = std::fs::read(dir.join("a.csv")).unwrap();
+    assert_eq!(a, std::fs::read(dir.join("b.csv")).unwrap());
+    assert_eq!(a, std::fs::read(dir.join("c.csv")).unwrap());
+}
+
+#[test]
+fn bad_input_is_refused_with_the_file_and_line_and_writes_nothing() {
+    let dir = scratch("bad");
+    std::fs::write(dir.join("bad.w"), "RK4\n0.001 1\n1 2 3\n").unwrap();
+    std::fs::write(
+        dir.join("bad.toml"),
+        "name = \"x\"\n[simulation]\nintegrator = \"rk5\"\ndt = 0.001\nsteps = 10\nevery = 1\n",
+    )
+    .unwrap();
+    let cases: [(&[&str], &str); 5] = [
+        (
+            &["run", "bad.w", "--trajectory", "t.csv"],
+            "bad.w:3: unexpected end of file: expected dCollision",
+        ),
+        (&["run", "bad.toml", "--trajectory", "t.csv"], "line 3"),
+        (
+            &["run", "no-such-scene", "--trajectory", "t.csv"],
+            "no built-in scene 'no-such-scene'",
+        ),
+        (
+            &["run", "chain", "--dt", "-1", "--trajectory", "t.csv"],
+            "--dt: expected a finite number > 0, found -1",
+        ),
+        (
+            &[
+                "run",
+                "cloth-table",
+                "--table",
+                "missing.obj",
+                "--trajectory",
+                "t.csv",
+            ],
+            "missing.obj",
+        ),
+    ];
+    for (args, expected) in cases {
+        let out = hooke(args, &dir);
+        assert!(!out.status.success(), "{args:?} should fail");
+        let e = stderr(&out);
+        assert!(
+            e.contains(expected),
+            "{args:?}: expected '{expected}' in:\n{e}"
+        );
+        assert!(!e.contains("panicked"), "{args:?} panicked:\n{e}");
+        assert!(!dir.join("t.csv").exists(), "{args:?} left an output file");
+    }
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(
+        leftovers.len(),
+        2,
+        "temporary files left behind: {leftovers:?}"
+    );
+}
+
+#[test]
+fn divergence_names_the_step_and_particle_and_keeps_complete_frames() {
+    let dir = scratch("diverge");
+    let out = hooke(
+        &[
+            "run",
+            "jello-cube",
+            "--dt",
+            "0.01",
+            "--steps",
+            "2000",
+            "--every",
+            "1",
+            "--trajectory",
+            "t.csv",
+        ],
+        &dir,
+    );
+    assert!(!out.status.success());
+    let e = stderr(&out);
+    assert!(
+        e.contains("diverged at step") && e.contains("particle") && e.contains("try --dt"),
+        "{e}"
+    );
+    let text = std::fs::read_to_string(dir.join("t.csv")).unwrap();
+    let rows = text.lines().count() - 1;
+    assert!(
+        rows > 0 && rows % 512 == 0,
+        "{rows} rows is not a whole number of frames"
+    );
+}
+
+#[test]
+fn the_table_can_be_swapped_from_the_command_line() {
+    let dir = scratch("table");
+    let square = root().join("assets/meshes/square-table.obj");
+    let out = hooke(
+        &[
+            "run",
+            "cloth-table",
+            "--table",
+            square.to_str().unwrap(),
+            "--steps",
+            "100",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = hooke(
+        &[
+            "run",
+            "cloth-table",
+            "--table",
+            "cylinder",
+            "--steps",
+            "100",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = hooke(
+        &["run", "chain", "--table", "cylinder", "--steps", "100"],
+        &dir,
+    );
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("has no table"), "{}", stderr(&out));
+}
