@@ -1,6 +1,9 @@
 //! `hooke`: run, render and inspect mass-spring scenes.
 
+mod draw;
+mod image_out;
 mod output;
+mod picture;
 mod run;
 mod source;
 mod trajectory;
@@ -24,6 +27,17 @@ struct Cli {
 enum Command {
     /// Simulate a scene: a built-in name, a .toml scene file or a .w jello world.
     Run(RunArgs),
+    /// Render a still of a scene at a given time to PNG.
+    Render(RenderArgs),
+    /// The main job: simulate the five built-in scenes and write a still of each plus an
+    /// animation.
+    Demo {
+        /// Output folder.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        #[command(flatten)]
+        view: image_out::View,
+    },
     /// List the built-in scenes.
     Scenes,
     /// Print a built-in scene as TOML (`hooke run` accepts it and reproduces the same run).
@@ -95,6 +109,30 @@ struct RunArgs {
     /// Print a summary line per frame: energies, bounding box, max speed, max penetration.
     #[arg(long)]
     summary: bool,
+    /// Write every frame as a numbered PNG into this folder.
+    #[arg(long, value_name = "DIR")]
+    frames: Option<PathBuf>,
+    /// Write the frames as a looping GIF animation.
+    #[arg(long, value_name = "FILE.gif")]
+    gif: Option<PathBuf>,
+    #[command(flatten)]
+    view: image_out::View,
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    /// Built-in name, .toml scene or .w world.
+    scene: String,
+    /// Simulated time of the still, seconds (default: the end of the scene's run).
+    #[arg(long, allow_negative_numbers = true)]
+    at: Option<f64>,
+    /// Output PNG.
+    #[arg(short, long, value_name = "FILE.png")]
+    output: PathBuf,
+    #[command(flatten)]
+    setup: SetupArgs,
+    #[command(flatten)]
+    view: image_out::View,
 }
 
 fn main() -> ExitCode {
@@ -111,6 +149,8 @@ fn main() -> ExitCode {
 fn dispatch(command: Command) -> Result<ExitCode> {
     match command {
         Command::Run(args) => run::run(&args),
+        Command::Render(args) => picture::render(&args),
+        Command::Demo { out, view } => picture::demo(&out, &view),
         Command::Scenes => {
             for (name, make) in hooke_scene::builtin::BUILTINS {
                 println!("{name:<14} {}", make().description);

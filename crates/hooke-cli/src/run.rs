@@ -4,19 +4,16 @@ use crate::source;
 use crate::trajectory::TrajectoryWriter;
 use crate::{RunArgs, SetupArgs};
 use anyhow::{Context, Result, bail};
-use hooke_core::{Divergence, Integrator, Simulation, StabilityEstimate, Summary};
+use hooke_core::{Divergence, Integrator, StabilityEstimate, Summary};
 use hooke_scene::Scene;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::Path;
 use std::process::ExitCode;
 
-/// Steps `scene` to its end, calling `on_frame(frame, simulation)` at frame 0 and after every
+/// Steps `scene` to its end, calling `on_frame(frame, scene)` at frame 0 and after every
 /// `every` steps. A divergence comes back as an error holding a [`Divergence`].
-pub fn drive(
-    scene: &mut Scene,
-    mut on_frame: impl FnMut(u64, &Simulation) -> Result<()>,
-) -> Result<()> {
+pub fn drive(scene: &mut Scene, mut on_frame: impl FnMut(u64, &Scene) -> Result<()>) -> Result<()> {
     let (steps, every) = (scene.steps, scene.every);
     let progress = if std::io::stderr().is_terminal() && steps >= 10_000 {
         let bar = ProgressBar::new(steps);
@@ -32,15 +29,14 @@ pub fn drive(
     } else {
         ProgressBar::hidden()
     };
-    let sim = &mut scene.simulation;
-    on_frame(0, sim)?;
+    on_frame(0, scene)?;
     for frame in 1..=steps / every {
-        sim.advance(every)?;
-        on_frame(frame, sim)?;
-        progress.set_position(sim.steps());
+        scene.simulation.advance(every)?;
+        on_frame(frame, scene)?;
+        progress.set_position(scene.simulation.steps());
     }
     // Steps past the last full frame are still run: the run's length is what was asked for.
-    sim.advance(steps % every)?;
+    scene.simulation.advance(steps % every)?;
     progress.finish_and_clear();
     Ok(())
 }
@@ -88,7 +84,14 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
             "max depth"
         );
     }
-    let result = drive(&mut scene, |frame, sim| {
+    let mut frames = crate::picture::FrameSink::new(
+        args.frames.clone(),
+        args.gif.clone(),
+        args.view.clone(),
+        every as f64 * dt,
+    )?;
+    let result = drive(&mut scene, |frame, scene| {
+        let sim = &scene.simulation;
         // SPEC §6: the time of frame f is (f K) dt computed as one product.
         let time = (frame * every) as f64 * dt;
         if let Some(t) = trajectory.as_mut() {
@@ -107,12 +110,18 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
                 s.max_penetration
             );
         }
+        if let Some(f) = frames.as_mut() {
+            f.frame(frame, scene)?;
+        }
         Ok(())
     });
     // After a divergence the frames already written are complete and are kept.
     if result.is_ok() || result.as_ref().is_err_and(is_divergence) {
         if let Some(t) = trajectory {
             t.finish()?;
+        }
+        if let Some(f) = frames {
+            f.finish()?;
         }
     }
     result?;

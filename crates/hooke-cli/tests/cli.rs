@@ -231,7 +231,7 @@ fn divergence_names_the_step_and_particle_and_keeps_complete_frames() {
     let text = std::fs::read_to_string(dir.join("t.csv")).unwrap();
     let rows = text.lines().count() - 1;
     assert!(
-        rows > 0 && rows % 512 == 0,
+        rows > 0 && rows.is_multiple_of(512),
         "{rows} rows is not a whole number of frames"
     );
 }

@@ -163,10 +163,8 @@ impl Model {
                     touched = true;
                     slot.response.resolve(&c, &mut x[p], &mut v[p]);
                 });
-                if !touched {
-                    if let Some(c) = slot.shape.crossing(&x0[p], &start) {
-                        slot.response.resolve(&c, &mut x[p], &mut v[p]);
-                    }
+                if !touched && let Some(c) = slot.shape.crossing(&x0[p], &start) {
+                    slot.response.resolve(&c, &mut x[p], &mut v[p]);
                 }
             }
         }

@@ -219,7 +219,7 @@ impl SceneSpec {
             (Some(n), None) => Ok(n),
             (None, Some(t)) => {
                 let n = (t.0 / sim.dt.0).round();
-                if n < 1.0 || n > 1e15 {
+                if !(1.0..=1e15).contains(&n) {
                     Err(invalid(
                         "simulation.duration",
                         format!(
@@ -357,7 +357,6 @@ impl SceneSpec {
             drag: self.simulation.drag.0,
             field,
             colliders: slots,
-            ..Model::default()
         };
         let simulation = Simulation::new(
             particles,

@@ -242,8 +242,11 @@ pub fn cloth_table() -> SceneSpec {
     }
 }
 
+/// Makes a built-in scene.
+pub type Maker = fn() -> SceneSpec;
+
 /// The built-in scenes by name, in the course document's order.
-pub const BUILTINS: [(&str, fn() -> SceneSpec); 5] = [
+pub const BUILTINS: [(&str, Maker); 5] = [
     ("single-spring", single_spring),
     ("chain", chain),
     ("jello-cube", jello_cube),

@@ -4,6 +4,10 @@ use super::{Workspace, accelerations};
 use crate::model::Model;
 use crate::particles::Particles;
 
+#[allow(
+    clippy::needless_range_loop,
+    reason = "six arrays advance in lockstep; one index reads clearest"
+)]
 pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) {
     let half = 0.5 * dt;
     ws.x0.copy_from_slice(&p.x);

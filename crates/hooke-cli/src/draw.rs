@@ -1,0 +1,306 @@
+//! Turning a scene's particles, springs and colliders into a draw list for the rasterizer.
+
+use hooke_core::{SpringKind, Vec3};
+use hooke_render::{Camera, DrawList, Line, Point, Rgb};
+use hooke_scene::{ColliderGeometry, Scene, Topology};
+
+/// What to draw of the bodies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Style {
+    /// Shaded surfaces (cloth, jelly); chains as beads on a string.
+    Solid,
+    /// Every spring as a line, coloured by kind.
+    Springs,
+    /// Surfaces and springs together.
+    Both,
+}
+
+const CLOTH: Rgb = [0.22, 0.42, 0.78];
+const JELLY: Rgb = [0.36, 0.74, 0.30];
+const BEAD: Rgb = [0.80, 0.30, 0.20];
+const STRING: Rgb = [0.25, 0.25, 0.28];
+const TABLE: Rgb = [0.58, 0.40, 0.24];
+const PLANE: Rgb = [0.85, 0.55, 0.65];
+const EDGE: Rgb = [0.25, 0.28, 0.35];
+/// How far below their true place colliders are drawn, metres.
+const DRAW_SINK: f64 = 0.002;
+const GROUND: [Rgb; 2] = [[0.78, 0.78, 0.76], [0.68, 0.68, 0.66]];
+
+/// The spring palette: the course's white / red / yellow, darkened to read on a light ground.
+fn spring_color(kind: SpringKind) -> Rgb {
+    match kind {
+        SpringKind::Structural => [0.15, 0.20, 0.45],
+        SpringKind::Shear => [0.80, 0.20, 0.20],
+        SpringKind::Bend => [0.90, 0.62, 0.05],
+        SpringKind::Other => STRING,
+    }
+}
+
+/// Adds a `rows × cols` sheet of particles (`index(r, c)`) as smooth-shaded triangles.
+fn sheet(
+    list: &mut DrawList,
+    x: &[Vec3],
+    rows: usize,
+    cols: usize,
+    index: impl Fn(usize, usize) -> usize,
+    color: Rgb,
+) {
+    if rows < 2 || cols < 2 {
+        return;
+    }
+    let mut normals = vec![Vec3::zeros(); rows * cols];
+    let at = |r: usize, c: usize| x[index(r, c)];
+    for r in 0..rows - 1 {
+        for c in 0..cols - 1 {
+            let n = (at(r + 1, c) - at(r, c)).cross(&(at(r, c + 1) - at(r, c)));
+            for (rr, cc) in [(r, c), (r + 1, c), (r, c + 1), (r + 1, c + 1)] {
+                normals[rr * cols + cc] += n;
+            }
+        }
+    }
+    let normal = |r: usize, c: usize| {
+        normals[r * cols + c]
+            .try_normalize(1e-18)
+            .unwrap_or(Vec3::y())
+    };
+    for r in 0..rows - 1 {
+        for c in 0..cols - 1 {
+            for tri in [
+                [(r, c), (r + 1, c), (r + 1, c + 1)],
+                [(r, c), (r + 1, c + 1), (r, c + 1)],
+            ] {
+                list.triangles.push(hooke_render::Triangle {
+                    p: tri.map(|(a, b)| at(a, b)),
+                    n: tri.map(|(a, b)| normal(a, b)),
+                    color,
+                });
+            }
+        }
+    }
+}
+
+fn ground(list: &mut DrawList, height: f64, centre: Vec3, half: f64) {
+    let tile = 0.25;
+    let n = (half / tile).ceil() as i64;
+    let (cx, cz) = (
+        (centre.x / tile).round() * tile,
+        (centre.z / tile).round() * tile,
+    );
+    for i in -n..n {
+        for j in -n..n {
+            let (x0, z0) = (cx + i as f64 * tile, cz + j as f64 * tile);
+            let p = |dx: f64, dz: f64| Vec3::new(x0 + dx, height, z0 + dz);
+            let color = GROUND[((i + j).rem_euclid(2)) as usize];
+            list.flat([p(0.0, 0.0), p(0.0, tile), p(tile, tile)], color);
+            list.flat([p(0.0, 0.0), p(tile, tile), p(tile, 0.0)], color);
+        }
+    }
+}
+
+fn cylinder(list: &mut DrawList, c: &hooke_collide::Cylinder) {
+    let segments = 64;
+    let top = c.center.y;
+    let bottom = top - c.thickness;
+    for k in 0..segments {
+        let a0 = std::f64::consts::TAU * k as f64 / segments as f64;
+        let a1 = std::f64::consts::TAU * (k + 1) as f64 / segments as f64;
+        let rim = |a: f64, y: f64| {
+            Vec3::new(
+                c.center.x + c.radius * a.cos(),
+                y,
+                c.center.z + c.radius * a.sin(),
+            )
+        };
+        list.flat(
+            [
+                Vec3::new(c.center.x, top, c.center.z),
+                rim(a1, top),
+                rim(a0, top),
+            ],
+            TABLE,
+        );
+        list.flat([rim(a0, bottom), rim(a1, top), rim(a1, bottom)], TABLE);
+        list.flat([rim(a0, bottom), rim(a0, top), rim(a1, top)], TABLE);
+    }
+}
+
+fn box_edges(list: &mut DrawList, min: Vec3, max: Vec3) {
+    let corner = |c: usize| {
+        Vec3::new(
+            if c & 4 != 0 { max.x } else { min.x },
+            if c & 2 != 0 { max.y } else { min.y },
+            if c & 1 != 0 { max.z } else { min.z },
+        )
+    };
+    for a in 0..8 {
+        for bit in [1, 2, 4] {
+            if a & bit == 0 {
+                list.lines.push(Line {
+                    a: corner(a),
+                    b: corner(a | bit),
+                    color: EDGE,
+                    width: 1.5,
+                });
+            }
+        }
+    }
+}
+
+/// The polygon where the plane `a x + b y + c z + d = 0` cuts the box, as a triangle fan.
+fn plane_in_box(list: &mut DrawList, coefficients: [f64; 4], min: Vec3, max: Vec3) {
+    let [a, b, c, d] = coefficients;
+    let f = |p: &Vec3| a * p.x + b * p.y + c * p.z + d;
+    let corner = |k: usize| {
+        Vec3::new(
+            if k & 4 != 0 { max.x } else { min.x },
+            if k & 2 != 0 { max.y } else { min.y },
+            if k & 1 != 0 { max.z } else { min.z },
+        )
+    };
+    let mut points = Vec::new();
+    for k in 0..8 {
+        for bit in [1, 2, 4] {
+            if k & bit == 0 {
+                let (p, q) = (corner(k), corner(k | bit));
+                let (fp, fq) = (f(&p), f(&q));
+                if (fp <= 0.0) != (fq <= 0.0) {
+                    points.push(p + (q - p) * (fp / (fp - fq)));
+                }
+            }
+        }
+    }
+    if points.len() < 3 {
+        return;
+    }
+    let centre = points.iter().sum::<Vec3>() / points.len() as f64;
+    let n = Vec3::new(a, b, c).normalize();
+    let u = (points[0] - centre).normalize();
+    let v = n.cross(&u);
+    points.sort_by(|p, q| {
+        let ang = |x: &Vec3| (x - centre).dot(&v).atan2((x - centre).dot(&u));
+        ang(p).total_cmp(&ang(q))
+    });
+    for k in 0..points.len() {
+        list.flat([centre, points[k], points[(k + 1) % points.len()]], PLANE);
+        list.lines.push(Line {
+            a: points[k],
+            b: points[(k + 1) % points.len()],
+            color: EDGE,
+            width: 1.0,
+        });
+    }
+}
+
+/// The draw list of a scene's current state.
+pub fn draw(scene: &Scene, style: Style) -> DrawList {
+    let mut list = DrawList::default();
+    let sim = &scene.simulation;
+    let x = &sim.particles().x;
+    let surfaces = style != Style::Springs;
+    for body in &scene.bodies {
+        let s = body.range.start;
+        match body.topology {
+            Topology::Grid([a, b]) if surfaces => {
+                sheet(&mut list, x, a, b, |r, c| s + r * b + c, CLOTH)
+            }
+            Topology::Lattice([a, b, c]) if surfaces => {
+                let idx = move |i: usize, j: usize, k: usize| s + (i * b + j) * c + k;
+                sheet(&mut list, x, a, b, |i, j| idx(i, j, 0), JELLY);
+                sheet(&mut list, x, a, b, |i, j| idx(i, j, c - 1), JELLY);
+                sheet(&mut list, x, a, c, |i, k| idx(i, 0, k), JELLY);
+                sheet(&mut list, x, a, c, |i, k| idx(i, b - 1, k), JELLY);
+                sheet(&mut list, x, b, c, |j, k| idx(0, j, k), JELLY);
+                sheet(&mut list, x, b, c, |j, k| idx(a - 1, j, k), JELLY);
+            }
+            Topology::Chain | Topology::Points => {
+                for i in body.range.clone() {
+                    list.points.push(Point {
+                        p: x[i],
+                        color: BEAD,
+                        radius: 6.0,
+                    });
+                }
+            }
+            _ => {}
+        }
+    }
+    let lines_for_all = style != Style::Solid;
+    let strings = scene
+        .bodies
+        .iter()
+        .filter(|b| matches!(b.topology, Topology::Chain | Topology::Points))
+        .map(|b| b.range.clone())
+        .collect::<Vec<_>>();
+    for spring in &sim.model().springs {
+        let (i, j) = (spring.i as usize, spring.j as usize);
+        let on_string = strings.iter().any(|r| r.contains(&i));
+        if lines_for_all || on_string {
+            let color = if on_string && !lines_for_all {
+                STRING
+            } else {
+                spring_color(spring.kind)
+            };
+            list.lines.push(Line {
+                a: x[i],
+                b: x[j],
+                color,
+                width: if on_string { 2.0 } else { 1.0 },
+            });
+        }
+    }
+    let body_bounds = list.bounds();
+    let mut box_bounds = None;
+    for c in &scene.colliders {
+        match c {
+            // Drawn 2 mm low: cloth resting exactly on a top would otherwise fight it in depth.
+            ColliderGeometry::Mesh(tris) => tris
+                .iter()
+                .for_each(|t| list.flat(t.map(|p| p - Vec3::y() * DRAW_SINK), TABLE)),
+            ColliderGeometry::Cylinder(cyl) => cylinder(&mut list, cyl),
+            ColliderGeometry::Box(b) => {
+                box_edges(&mut list, b.min, b.max);
+                box_bounds = Some((b.min, b.max));
+            }
+            _ => {}
+        }
+    }
+    for c in &scene.colliders {
+        match c {
+            ColliderGeometry::Plane(coefficients) => {
+                let (min, max) = box_bounds.unwrap_or((Vec3::repeat(-2.0), Vec3::repeat(2.0)));
+                plane_in_box(&mut list, *coefficients, min, max);
+            }
+            ColliderGeometry::Ground(h) => {
+                let centre = body_bounds.map_or(Vec3::zeros(), |(lo, hi)| (lo + hi) * 0.5);
+                ground(&mut list, *h, centre, 2.5);
+            }
+            _ => {}
+        }
+    }
+    list
+}
+
+/// A camera that frames the bodies and colliders (not the ground) from a three-quarter view.
+pub fn frame_camera(scene: &Scene, yaw: f64, pitch: f64) -> Camera {
+    let x = &scene.simulation.particles().x;
+    let mut lo = x.iter().fold(Vec3::repeat(f64::INFINITY), |a, p| a.inf(p));
+    let mut hi = x
+        .iter()
+        .fold(Vec3::repeat(f64::NEG_INFINITY), |a, p| a.sup(p));
+    for c in &scene.colliders {
+        let pts: Vec<Vec3> = match c {
+            ColliderGeometry::Mesh(t) => t.iter().flatten().copied().collect(),
+            ColliderGeometry::Cylinder(c) => vec![
+                c.center + Vec3::new(c.radius, 0.0, c.radius),
+                c.center - Vec3::new(c.radius, c.thickness, c.radius),
+            ],
+            ColliderGeometry::Box(b) => vec![b.min, b.max],
+            _ => vec![],
+        };
+        for p in pts {
+            lo = lo.inf(&p);
+            hi = hi.sup(&p);
+        }
+    }
+    Camera::framing(lo, hi, yaw, pitch)
+}
