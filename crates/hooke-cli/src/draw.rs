@@ -124,14 +124,18 @@ fn cylinder(list: &mut DrawList, c: &hooke_collide::Cylinder) {
     }
 }
 
+/// Corner `k` of the box: x from bit 2, y from bit 1, z from bit 0.
+fn box_corner(min: Vec3, max: Vec3, k: usize) -> Vec3 {
+    let pick = |bit: usize, lo: f64, hi: f64| if k & bit != 0 { hi } else { lo };
+    Vec3::new(
+        pick(4, min.x, max.x),
+        pick(2, min.y, max.y),
+        pick(1, min.z, max.z),
+    )
+}
+
 fn box_edges(list: &mut DrawList, min: Vec3, max: Vec3) {
-    let corner = |c: usize| {
-        Vec3::new(
-            if c & 4 != 0 { max.x } else { min.x },
-            if c & 2 != 0 { max.y } else { min.y },
-            if c & 1 != 0 { max.z } else { min.z },
-        )
-    };
+    let corner = |k: usize| box_corner(min, max, k);
     for a in 0..8 {
         for bit in [1, 2, 4] {
             if a & bit == 0 {
@@ -150,13 +154,7 @@ fn box_edges(list: &mut DrawList, min: Vec3, max: Vec3) {
 fn plane_in_box(list: &mut DrawList, coefficients: [f64; 4], min: Vec3, max: Vec3) {
     let [a, b, c, d] = coefficients;
     let f = |p: &Vec3| a * p.x + b * p.y + c * p.z + d;
-    let corner = |k: usize| {
-        Vec3::new(
-            if k & 4 != 0 { max.x } else { min.x },
-            if k & 2 != 0 { max.y } else { min.y },
-            if k & 1 != 0 { max.z } else { min.z },
-        )
-    };
+    let corner = |k: usize| box_corner(min, max, k);
     let mut points = Vec::new();
     for k in 0..8 {
         for bit in [1, 2, 4] {

@@ -334,3 +334,96 @@ fn downsample(color: &[Rgb], width: usize, height: usize, ss: usize) -> Vec<u8> 
         });
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::draw_list::{Line, Point};
+
+    fn scene() -> DrawList {
+        let mut list = DrawList::default();
+        for k in 0..200 {
+            let a = k as f64 * 0.1;
+            let p = |r: f64, y: f64| Vector3::new(r * a.cos(), y, r * a.sin());
+            list.flat(
+                [p(0.2, 0.0), p(1.0, 0.3 + 0.01 * k as f64), p(0.6, 1.0)],
+                [0.2 + (k % 7) as f32 * 0.1, 0.5, 0.3],
+            );
+        }
+        list.lines.push(Line {
+            a: Vector3::new(-1.0, 0.0, 0.0),
+            b: Vector3::new(1.0, 1.0, 0.0),
+            color: [0.0; 3],
+            width: 2.0,
+        });
+        list.points.push(Point {
+            p: Vector3::new(0.0, 0.5, 0.0),
+            color: [1.0, 0.0, 0.0],
+            radius: 5.0,
+        });
+        list
+    }
+
+    #[test]
+    fn pixels_do_not_depend_on_the_thread_count() {
+        let list = scene();
+        let camera = Camera::framing(
+            Vector3::new(-1.0, 0.0, -1.0),
+            Vector3::new(1.0, 3.0, 1.0),
+            30.0,
+            20.0,
+        );
+        let options = RenderOptions {
+            width: 160,
+            height: 120,
+            ..RenderOptions::default()
+        };
+        let on = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| render(&list, &camera, &options))
+        };
+        let one = on(1);
+        assert_eq!(one, on(2));
+        assert_eq!(one, on(3));
+        // And the picture is not empty: some pixels differ from the background.
+        let background = &one[..4];
+        assert!(one.chunks(4).filter(|p| p != &background).count() > 1000);
+    }
+
+    #[test]
+    fn nearer_triangles_hide_farther_ones() {
+        let mut list = DrawList::default();
+        let quad = |list: &mut DrawList, z: f64, color| {
+            let p = |x: f64, y: f64| Vector3::new(x, y, z);
+            list.flat([p(-1.0, -1.0), p(1.0, -1.0), p(1.0, 1.0)], color);
+            list.flat([p(-1.0, -1.0), p(1.0, 1.0), p(-1.0, 1.0)], color);
+        };
+        // Drawn far-after-near, so only the depth test can put red in front.
+        quad(&mut list, 0.5, [1.0, 0.0, 0.0]);
+        quad(&mut list, -0.5, [0.0, 0.0, 1.0]);
+        let camera = Camera {
+            target: Vector3::zeros(),
+            distance: 5.0,
+            yaw: 0.0,
+            pitch: 0.0,
+            fov_y: 40.0,
+        };
+        let px = render(
+            &list,
+            &camera,
+            &RenderOptions {
+                width: 32,
+                height: 32,
+                ..RenderOptions::default()
+            },
+        );
+        let centre = &px[(16 * 32 + 16) * 4..][..3];
+        assert!(
+            centre[0] > 50 && centre[2] < 10,
+            "centre pixel {centre:?} should be the red, nearer quad"
+        );
+    }
+}
