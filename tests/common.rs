@@ -18,10 +18,18 @@ pub fn builtin(name: &str, overrides: &Overrides) -> Scene {
     spec.build(&root().join("assets/scenes")).unwrap()
 }
 
+/// Magnitudes below this (a nanometre, a nanojoule, a nanometre per second) are round-off
+/// left by cancellation, such as the z of a particle on a plane of symmetry, not physics.
+pub const NOISE_FLOOR: f64 = 1e-9;
+
 /// Rounds to `digits` significant digits, for snapshots that must not depend on the last bits
-/// of libm's trigonometry on another platform.
+/// of libm's trigonometry or of the order forces are summed in; values below [`NOISE_FLOOR`]
+/// become 0.
 pub fn round_sig(x: f64, digits: i32) -> f64 {
-    if x == 0.0 || !x.is_finite() {
+    if x.abs() < NOISE_FLOOR {
+        return 0.0;
+    }
+    if !x.is_finite() {
         return x;
     }
     let scale = 10f64.powi(digits - 1 - x.abs().log10().floor() as i32);

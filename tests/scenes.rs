@@ -61,8 +61,9 @@ pub fn tracked(scene: &Scene) -> Vec<usize> {
 }
 
 /// Positions of the tracked particles and the frame summary at a few frames, rounded to six
-/// significant digits: enough to catch any change to the physics, while the last bits of
-/// libm's sin/cos (used to place rotated bodies) cannot flip a digit.
+/// significant digits (values under a nanounit are zeroed, see [`crate::common::round_sig`]):
+/// enough to catch any change to the physics, while the last bits of libm's sin/cos (used to
+/// place rotated bodies) or of the force summation order cannot flip a digit.
 pub fn trajectory_report(scene: &mut Scene, checkpoints: &[u64]) -> String {
     let ids = tracked(scene);
     let mut out = String::new();

@@ -30,10 +30,12 @@
 //!
 //! Build with `--release`: unoptimised nalgebra arithmetic is tens of times slower.
 
+mod assembly;
 mod collider;
 mod force_field;
 pub mod integrator;
 mod model;
+mod parallel;
 mod particles;
 mod response;
 mod simulation;
@@ -44,7 +46,8 @@ mod summary;
 pub use collider::{Collider, Contact};
 pub use force_field::{FIELD_HALF_EXTENT, ForceField};
 pub use integrator::{Integrator, UnknownIntegrator, Workspace};
-pub use model::{Adjacency, ColliderSlot, Model};
+pub use assembly::Assembly;
+pub use model::{ColliderSlot, Model};
 pub use particles::{Particles, Vec3};
 pub use response::Response;
 pub use simulation::{Divergence, SANE_BOUND, Simulation};

@@ -63,15 +63,7 @@ impl Spring {
     /// ```
     #[inline]
     pub fn force(&self, xi: &Vec3, xj: &Vec3, vi: &Vec3, vj: &Vec3) -> Vec3 {
-        let d = xi - xj;
-        let len = d.norm();
-        if len < DEGENERATE_LENGTH {
-            return Vec3::zeros();
-        }
-        let u = d / len;
-        let elastic = -self.ks * (len - self.rest);
-        let damping = -self.kd * (vi - vj).dot(&u);
-        u * elastic + u * damping
+        spring_force(xi - xj, vi - vj, self.rest, self.ks, self.kd)
     }
 
     /// Elastic potential energy `ks (L - l)² / 2` in joules.
@@ -79,4 +71,17 @@ impl Spring {
         let stretch = (xi - xj).norm() - self.rest;
         0.5 * self.ks * stretch * stretch
     }
+}
+
+/// The force on the `i` end of a spring from `d = x_i - x_j` and `dv = v_i - v_j` (SPEC §1):
+/// `(-ks (|d| - rest) - kd dv·u) u` with `u = d / |d|`; zero for a degenerate spring. The one
+/// formula every force path uses, so they agree to the bit.
+#[inline]
+pub(crate) fn spring_force(d: Vec3, dv: Vec3, rest: f64, ks: f64, kd: f64) -> Vec3 {
+    let len = d.norm();
+    if len < DEGENERATE_LENGTH {
+        return Vec3::zeros();
+    }
+    let u = d / len;
+    u * (-ks * (len - rest) - kd * dv.dot(&u))
 }

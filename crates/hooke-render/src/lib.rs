@@ -3,7 +3,7 @@
 //! World-space triangles, lines and points plus a [`Camera`] in, RGBA pixels out. No
 //! physics, no files: the CLI turns particles, springs and colliders into a [`DrawList`] and
 //! encodes the pixels. Two-sided Lambert + ambient + a little specular lighting, a z-buffer,
-//! 4× supersampling by default, rows rendered in parallel bands with one writer per pixel,
+//! 4× supersampling by default, tiles rendered in parallel with one writer per pixel,
 //! so the same frame gives the same pixels on any number of threads.
 //!
 //! ```
@@ -20,7 +20,11 @@
 
 mod camera;
 mod draw_list;
+mod bins;
 mod raster;
+mod setup;
+mod shading;
+mod tile;
 
 pub use camera::Camera;
 pub use draw_list::{DrawList, Line, Point, Rgb, Triangle};

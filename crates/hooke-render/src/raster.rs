@@ -1,14 +1,21 @@
-//! The rasterizer: z-buffered triangles, lines and points into a supersampled buffer, rows
-//! split into bands with one writer each, then averaged down.
+//! The rasterizer: tiles of samples kept in cache, each filled with every primitive that
+//! touches it and resolved straight into output pixels, so no full-size supersampled frame
+//! is ever allocated.
 //!
-//! Each band walks every primitive in list order, so the picture is the same bits whatever
-//! the number of threads. Attributes are interpolated perspective-correctly: barycentrics are
-//! weighted by `1/w` and renormalised (the derivation is in Low, "Perspective-Correct
-//! Interpolation", 2002).
+//! The pipeline: primitive setup in parallel over the draw list (projection, fixed-point
+//! corners, sample rectangles); binning into tiles in fixed chunks; then in parallel over
+//! tiles, scan conversion into a depth + primitive-id buffer and a resolve that shades each
+//! distinct primitive of a pixel once. Every tile sees its primitives in draw-list order and
+//! no two tiles share a pixel, so the picture is the same bits whatever the thread count.
+//! Attributes are interpolated perspective-correctly: barycentrics are weighted by `1/w`
+//! and renormalised (Low, "Perspective-Correct Interpolation", 2002).
 
+use crate::bins::{Bins, Grid};
 use crate::camera::Camera;
 use crate::draw_list::{DrawList, Rgb};
-use nalgebra::{Vector3, Vector4};
+use crate::setup::{Frame, LineSetup, PointSetup, Rect, TriSetup};
+use crate::shading::Shading;
+use crate::tile::{EMPTY, Samples};
 use rayon::prelude::*;
 
 /// How to render.
@@ -35,303 +42,170 @@ impl Default for RenderOptions {
     }
 }
 
-/// Rows per band: small enough to share work between two cores evenly, large enough that
-/// walking the primitive list per band costs little.
-const BAND: usize = 16;
+/// Tile side in output pixels: with 4× supersampling a tile's depth and id buffers take
+/// 128 KiB, which stays in a core's L2 cache.
+pub const TILE: u32 = 64;
 
-#[derive(Clone, Copy)]
-struct Projected {
-    x: f64,
-    y: f64,
-    z: f64,
-    inv_w: f64,
+/// Everything the resolve needs to shade a sample's primitive.
+struct Prepared<'a> {
+    list: &'a DrawList,
+    tris: Vec<TriSetup>,
+    lines: Vec<LineSetup>,
+    points: Vec<PointSetup>,
+    shading: Shading,
+    options: &'a RenderOptions,
+    ss: u32,
 }
 
-fn project(
-    m: &nalgebra::Matrix4<f64>,
-    p: &Vector3<f64>,
-    near: f64,
-    w: f64,
-    h: f64,
-) -> Option<Projected> {
-    let c = m * Vector4::new(p.x, p.y, p.z, 1.0);
-    if c.w < near {
-        return None;
-    }
-    let inv_w = 1.0 / c.w;
-    Some(Projected {
-        x: (c.x * inv_w + 1.0) * 0.5 * w,
-        y: (1.0 - c.y * inv_w) * 0.5 * h,
-        z: c.z * inv_w,
-        inv_w,
-    })
-}
-
-struct Target<'a> {
-    color: &'a mut [Rgb],
-    depth: &'a mut [f64],
-    y0: usize,
-    rows: usize,
-    width: usize,
-}
-
-impl Target<'_> {
-    #[inline]
-    fn test_and_set(&mut self, x: usize, y: usize, z: f64) -> Option<usize> {
-        let i = (y - self.y0) * self.width + x;
-        (z < self.depth[i]).then(|| {
-            self.depth[i] = z;
-            i
-        })
-    }
-}
-
-/// Lighting: a key light from the upper front-left in view terms, plus ambient and a little
-/// specular; surfaces are two-sided.
-struct Shading {
-    light: Vector3<f64>,
-    half: Vector3<f64>,
-    forward: Vector3<f64>,
-}
-
-impl Shading {
-    fn new(camera: &Camera) -> Self {
-        let forward = (camera.target - camera.eye()).normalize();
-        let right = forward.cross(&Vector3::y()).normalize();
-        let light = (Vector3::y() * 1.2 - right * 0.5 - forward * 0.6).normalize();
-        let half = (light - forward).normalize();
-        Self {
-            light,
-            half,
-            forward,
+impl Prepared<'_> {
+    /// The colour of primitive `id` at the sample-space point `p`.
+    fn shade(&self, id: u32, p: (f64, f64)) -> Rgb {
+        let id = id as usize;
+        let (nt, nl) = (self.tris.len(), self.lines.len());
+        if id < nt {
+            let s = &self.tris[id];
+            let t = &self.list.triangles[s.src as usize];
+            let w = s.weights(p);
+            self.shading
+                .shade(t.n[0] * w[0] + t.n[1] * w[1] + t.n[2] * w[2], t.color)
+        } else if id < nt + nl {
+            self.lines[id - nt].color
+        } else {
+            let s = &self.points[id - nt - nl];
+            let (u, v) = ((p.0 - s.c.0) / s.radius, (s.c.1 - p.1) / s.radius);
+            let r2 = (u * u + v * v).min(1.0);
+            let n = self.shading.right * u + self.shading.up * v
+                - self.shading.forward * (1.0 - r2).sqrt();
+            self.shading.shade(n, s.color)
         }
     }
 
-    fn shade(&self, n: Vector3<f64>, color: Rgb) -> Rgb {
-        let n = if n.dot(&self.forward) > 0.0 { -n } else { n };
-        let diffuse = n.dot(&self.light).max(0.0);
-        let specular = n.dot(&self.half).max(0.0).powi(32) * 0.25;
-        color.map(|c| (c as f64 * (0.35 + 0.65 * diffuse) + specular).min(1.0) as f32)
+    fn background(&self, row: u32) -> Rgb {
+        let t = (row as f32 + 0.5) / self.options.height as f32;
+        let [top, bottom] = self.options.background;
+        [0, 1, 2].map(|c| top[c] * (1.0 - t) + bottom[c] * t)
+    }
+
+    /// Shades and averages the tile's samples into RGBA8 pixels, row-major over the tile.
+    fn resolve(&self, s: &Samples) -> Vec<u8> {
+        let ss = self.ss;
+        let (px0, py0) = (s.area.x0 / ss, s.area.y0 / ss);
+        let (w, h) = ((s.area.x1 - s.area.x0) / ss, (s.area.y1 - s.area.y0) / ss);
+        let n = (ss * ss) as f32;
+        let mut out = vec![0u8; (w * h * 4) as usize];
+        let mut ids: Vec<(u32, u32)> = Vec::with_capacity((ss * ss) as usize);
+        for y in 0..h {
+            let background = self.background(py0 + y);
+            for x in 0..w {
+                ids.clear();
+                for sy in 0..ss {
+                    for sx in 0..ss {
+                        let id = s.id[s.index(s.area.x0 + x * ss + sx, s.area.y0 + y * ss + sy)];
+                        match ids.iter_mut().find(|(i, _)| *i == id) {
+                            Some((_, count)) => *count += 1,
+                            None => ids.push((id, 1)),
+                        }
+                    }
+                }
+                let centre = (
+                    ((px0 + x) * ss) as f64 + ss as f64 * 0.5,
+                    ((py0 + y) * ss) as f64 + ss as f64 * 0.5,
+                );
+                let mut sum = [0.0f32; 3];
+                for &(id, count) in &ids {
+                    let c = if id == EMPTY {
+                        background
+                    } else {
+                        self.shade(id, centre)
+                    };
+                    for k in 0..3 {
+                        sum[k] += c[k] * count as f32;
+                    }
+                }
+                let o = ((y * w + x) * 4) as usize;
+                for k in 0..3 {
+                    out[o + k] = (sum[k] / n * 255.0).round().clamp(0.0, 255.0) as u8;
+                }
+                out[o + 3] = 255;
+            }
+        }
+        out
     }
 }
 
 /// Renders `list` seen by `camera` into an RGBA8 image of `width × height` pixels, row-major.
 pub fn render(list: &DrawList, camera: &Camera, options: &RenderOptions) -> Vec<u8> {
-    let ss = options.supersample.max(1) as usize;
-    let (w, h) = (options.width as usize * ss, options.height as usize * ss);
-    let m = camera.view_projection(w as f64 / h as f64);
-    let near = camera.near();
-    let (wf, hf) = (w as f64, h as f64);
-    let tris: Vec<Option<[Projected; 3]>> = list
+    let ss = options.supersample.max(1);
+    let (w, h) = (options.width * ss, options.height * ss);
+    let frame = Frame::new(camera, w, h);
+    let per_pixel = ss as f64;
+    let tris: Vec<TriSetup> = list
         .triangles
         .par_iter()
-        .map(|t| {
-            Some([
-                project(&m, &t.p[0], near, wf, hf)?,
-                project(&m, &t.p[1], near, wf, hf)?,
-                project(&m, &t.p[2], near, wf, hf)?,
-            ])
-        })
+        .enumerate()
+        .filter_map(|(i, t)| TriSetup::new(&frame, t, i as u32))
         .collect();
-    let lines: Vec<Option<[Projected; 2]>> = list
+    let lines: Vec<LineSetup> = list
         .lines
-        .iter()
-        .map(|l| {
-            Some([
-                project(&m, &l.a, near, wf, hf)?,
-                project(&m, &l.b, near, wf, hf)?,
-            ])
-        })
+        .par_iter()
+        .filter_map(|l| LineSetup::new(&frame, l, per_pixel))
         .collect();
-    let points: Vec<Option<Projected>> = list
+    let points: Vec<PointSetup> = list
         .points
-        .iter()
-        .map(|p| project(&m, &p.p, near, wf, hf))
+        .par_iter()
+        .filter_map(|p| PointSetup::new(&frame, p, per_pixel))
         .collect();
-    let shading = Shading::new(camera);
+    let grid = Grid::new(w, h, TILE * ss);
+    let tri_bins = Bins::new(&tris, |t| t.rect, &grid);
+    let line_bins = Bins::new(&lines, |l| l.rect, &grid);
+    let point_bins = Bins::new(&points, |p| p.rect, &grid);
+    let prepared = Prepared {
+        list,
+        tris,
+        lines,
+        points,
+        shading: Shading::new(camera),
+        options,
+        ss,
+    };
+    let (nt, nl) = (prepared.tris.len() as u32, prepared.lines.len() as u32);
 
-    let mut color = vec![[0.0f32; 3]; w * h];
-    let mut depth = vec![f64::INFINITY; w * h];
-    color
-        .par_chunks_mut(BAND * w)
-        .zip(depth.par_chunks_mut(BAND * w))
-        .enumerate()
-        .for_each(|(band, (color, depth))| {
-            let y0 = band * BAND;
-            let rows = color.len() / w;
-            for (r, row) in color.chunks_mut(w).enumerate() {
-                let t = (y0 + r) as f32 / h as f32;
-                let [top, bottom] = options.background;
-                row.fill([0, 1, 2].map(|c| top[c] * (1.0 - t) + bottom[c] * t));
-            }
-            let mut target = Target {
-                color,
-                depth,
-                y0,
-                rows,
-                width: w,
-            };
-            for (t, s) in list.triangles.iter().zip(&tris) {
-                if let Some(s) = s {
-                    triangle(&mut target, s, |b| {
-                        let n = t.n[0] * b[0] + t.n[1] * b[1] + t.n[2] * b[2];
-                        shading.shade(n.try_normalize(1e-12).unwrap_or(t.n[0]), t.color)
-                    });
+    let tiles: Vec<Vec<u8>> = (0..grid.count())
+        .into_par_iter()
+        .map_init(
+            || Samples::new(grid.side),
+            |samples, t| {
+                let (tx, ty) = (t as u32 % grid.across, t as u32 / grid.across);
+                samples.reset(Rect {
+                    x0: tx * grid.side,
+                    y0: ty * grid.side,
+                    x1: ((tx + 1) * grid.side).min(w),
+                    y1: ((ty + 1) * grid.side).min(h),
+                });
+                for id in tri_bins.tile(t) {
+                    samples.triangle(&prepared.tris[id as usize], id);
                 }
-            }
-            for (l, s) in list.lines.iter().zip(&lines) {
-                if let Some([a, b]) = s {
-                    line(&mut target, a, b, l.width as f64 * ss as f64, l.color);
+                for id in line_bins.tile(t) {
+                    samples.line(&prepared.lines[id as usize], nt + id);
                 }
-            }
-            for (p, s) in list.points.iter().zip(&points) {
-                if let Some(c) = s {
-                    ball(
-                        &mut target,
-                        c,
-                        p.radius as f64 * ss as f64,
-                        p.color,
-                        &shading,
-                    );
+                for id in point_bins.tile(t) {
+                    samples.point(&prepared.points[id as usize], nt + nl + id);
                 }
-            }
-        });
-    downsample(&color, options.width as usize, options.height as usize, ss)
-}
+                prepared.resolve(samples)
+            },
+        )
+        .collect();
 
-fn edge(a: (f64, f64), b: (f64, f64), p: (f64, f64)) -> f64 {
-    (b.0 - a.0) * (p.1 - a.1) - (b.1 - a.1) * (p.0 - a.0)
-}
-
-fn triangle(t: &mut Target, s: &[Projected; 3], shade: impl Fn([f64; 3]) -> Rgb) {
-    let pts = s.map(|p| (p.x, p.y));
-    let area = edge(pts[0], pts[1], pts[2]);
-    if area.abs() < 1e-12 {
-        return;
-    }
-    let (y_lo, y_hi) = (t.y0 as f64, (t.y0 + t.rows) as f64);
-    let min_x = pts
-        .iter()
-        .map(|p| p.0)
-        .fold(f64::INFINITY, f64::min)
-        .floor()
-        .max(0.0) as usize;
-    let max_x = (pts
-        .iter()
-        .map(|p| p.0)
-        .fold(f64::NEG_INFINITY, f64::max)
-        .ceil()
-        .min(t.width as f64))
-    .max(0.0) as usize;
-    let min_y = pts
-        .iter()
-        .map(|p| p.1)
-        .fold(f64::INFINITY, f64::min)
-        .floor()
-        .max(y_lo) as usize;
-    let max_y = (pts
-        .iter()
-        .map(|p| p.1)
-        .fold(f64::NEG_INFINITY, f64::max)
-        .ceil()
-        .min(y_hi))
-    .max(y_lo) as usize;
-    for y in min_y..max_y {
-        for x in min_x..max_x {
-            let p = (x as f64 + 0.5, y as f64 + 0.5);
-            let b = [
-                edge(pts[1], pts[2], p) / area,
-                edge(pts[2], pts[0], p) / area,
-                edge(pts[0], pts[1], p) / area,
-            ];
-            if b.iter().any(|&v| v < 0.0) {
-                continue;
-            }
-            let z = b[0] * s[0].z + b[1] * s[1].z + b[2] * s[2].z;
-            if let Some(i) = t.test_and_set(x, y, z) {
-                let pc = [b[0] * s[0].inv_w, b[1] * s[1].inv_w, b[2] * s[2].inv_w];
-                let sum = pc[0] + pc[1] + pc[2];
-                t.color[i] = shade(pc.map(|v| v / sum));
-            }
+    let (width, tile) = (options.width as usize, TILE as usize);
+    let mut out = vec![0u8; width * options.height as usize * 4];
+    for (t, pixels) in tiles.iter().enumerate() {
+        let (tx, ty) = (t % grid.across as usize, t / grid.across as usize);
+        let tile_width = tile.min(width - tx * tile);
+        for (r, row) in pixels.chunks(tile_width * 4).enumerate() {
+            let start = ((ty * tile + r) * width + tx * tile) * 4;
+            out[start..start + row.len()].copy_from_slice(row);
         }
     }
-}
-
-/// Lines sit on surfaces they outline; this much depth slack keeps them visible there.
-const LINE_DEPTH_BIAS: f64 = 2e-4;
-
-fn line(t: &mut Target, a: &Projected, b: &Projected, width: f64, color: Rgb) {
-    let (dx, dy) = (b.x - a.x, b.y - a.y);
-    let steps = (dx.abs().max(dy.abs()) * 2.0).ceil().max(1.0) as usize;
-    let half = (width * 0.5).max(0.5);
-    for k in 0..=steps {
-        let u = k as f64 / steps as f64;
-        let (cx, cy, z) = (
-            a.x + dx * u,
-            a.y + dy * u,
-            a.z + (b.z - a.z) * u - LINE_DEPTH_BIAS,
-        );
-        let y_lo = ((cy - half).floor().max(t.y0 as f64)) as usize;
-        let y_hi = ((cy + half).ceil().min((t.y0 + t.rows) as f64)).max(y_lo as f64) as usize;
-        let x_lo = (cx - half).floor().max(0.0) as usize;
-        let x_hi = ((cx + half).ceil().min(t.width as f64)).max(x_lo as f64) as usize;
-        for y in y_lo..y_hi {
-            for x in x_lo..x_hi {
-                if let Some(i) = t.test_and_set(x, y, z) {
-                    t.color[i] = color;
-                }
-            }
-        }
-    }
-}
-
-fn ball(t: &mut Target, c: &Projected, radius: f64, color: Rgb, shading: &Shading) {
-    let y_lo = ((c.y - radius).floor().max(t.y0 as f64)) as usize;
-    let y_hi = ((c.y + radius).ceil().min((t.y0 + t.rows) as f64)).max(y_lo as f64) as usize;
-    let x_lo = (c.x - radius).floor().max(0.0) as usize;
-    let x_hi = ((c.x + radius).ceil().min(t.width as f64)).max(x_lo as f64) as usize;
-    let right = shading.forward.cross(&Vector3::y()).normalize();
-    let up = right.cross(&shading.forward);
-    for y in y_lo..y_hi {
-        for x in x_lo..x_hi {
-            let (u, v) = (
-                (x as f64 + 0.5 - c.x) / radius,
-                (c.y - y as f64 - 0.5) / radius,
-            );
-            let r2 = u * u + v * v;
-            if r2 > 1.0 {
-                continue;
-            }
-            let n = right * u + up * v - shading.forward * (1.0 - r2).sqrt();
-            if let Some(i) = t.test_and_set(x, y, c.z - LINE_DEPTH_BIAS * 2.0) {
-                t.color[i] = shading.shade(n, color);
-            }
-        }
-    }
-}
-
-fn downsample(color: &[Rgb], width: usize, height: usize, ss: usize) -> Vec<u8> {
-    let mut out = vec![0u8; width * height * 4];
-    out.par_chunks_mut(width * 4)
-        .enumerate()
-        .for_each(|(y, row)| {
-            for x in 0..width {
-                let mut sum = [0.0f32; 3];
-                for sy in 0..ss {
-                    for sx in 0..ss {
-                        let c = color[(y * ss + sy) * width * ss + x * ss + sx];
-                        for k in 0..3 {
-                            sum[k] += c[k];
-                        }
-                    }
-                }
-                let n = (ss * ss) as f32;
-                for k in 0..3 {
-                    row[x * 4 + k] = (sum[k] / n * 255.0).round().clamp(0.0, 255.0) as u8;
-                }
-                row[x * 4 + 3] = 255;
-            }
-        });
     out
 }
 
@@ -339,6 +213,7 @@ fn downsample(color: &[Rgb], width: usize, height: usize, ss: usize) -> Vec<u8> 
 mod tests {
     use super::*;
     use crate::draw_list::{Line, Point};
+    use nalgebra::Vector3;
 
     fn scene() -> DrawList {
         let mut list = DrawList::default();

@@ -1,15 +1,17 @@
 //! Explicit Euler: `x' = x + dt v`, `v' = v + dt a(x, v)`, both from the old state.
 
-use super::{Workspace, accelerations};
+use super::{Workspace, accelerations, for_blocks};
 use crate::model::Model;
 use crate::particles::Particles;
 
 pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) {
     ws.x0.copy_from_slice(&p.x);
     let a = &mut ws.kv[0];
-    accelerations(model, &ws.adjacency, p, &p.x, &p.v, &mut ws.spring_force, a);
-    for ((x, v), a) in p.x.iter_mut().zip(p.v.iter_mut()).zip(a.iter()) {
-        *x += *v * dt;
-        *v += a * dt;
-    }
+    accelerations(model, &mut ws.assembly, p, &p.x, &p.v, a);
+    for_blocks(&mut p.x, &mut p.v, |start, x, v| {
+        for k in 0..x.len() {
+            x[k] += v[k] * dt;
+            v[k] += a[start + k] * dt;
+        }
+    });
 }

@@ -9,7 +9,9 @@ mod midpoint;
 mod rk4;
 mod symplectic;
 
-use crate::model::{Adjacency, Model};
+use crate::assembly::{Assembly, BLOCK};
+use crate::parallel;
+use crate::model::Model;
 use crate::particles::{Particles, Vec3};
 use std::fmt;
 use std::str::FromStr;
@@ -99,8 +101,7 @@ impl FromStr for Integrator {
 /// Stage buffers reused from step to step, so that stepping allocates nothing.
 #[derive(Clone, Debug, Default)]
 pub struct Workspace {
-    pub(crate) adjacency: Adjacency,
-    pub(crate) spring_force: Vec<Vec3>,
+    pub(crate) assembly: Assembly,
     /// Positions at the start of the current step.
     pub(crate) x0: Vec<Vec3>,
     pub(crate) v0: Vec<Vec3>,
@@ -115,11 +116,10 @@ pub struct Workspace {
 impl Workspace {
     fn ensure(&mut self, model: &Model, particles: usize) {
         let springs = model.springs.len();
-        if !self.adjacency.fits(particles, springs) {
-            self.adjacency = Adjacency::new(particles, &model.springs);
+        if !self.assembly.fits(particles, springs) {
+            self.assembly = Assembly::new(particles, &model.springs);
         }
         let zero = Vec3::zeros();
-        self.spring_force.resize(springs, zero);
         for buf in [&mut self.x0, &mut self.v0, &mut self.xt, &mut self.vt]
             .into_iter()
             .chain(self.kx.iter_mut())
@@ -135,15 +135,41 @@ impl Workspace {
     }
 }
 
-/// `a = model.accelerations(x, v)`, with the workspace's adjacency and spring buffer.
+/// `a = F(x, v) / m` with the workspace's assembly.
 fn accelerations(
     model: &Model,
-    adjacency: &Adjacency,
+    assembly: &mut Assembly,
     p: &Particles,
     x: &[Vec3],
     v: &[Vec3],
-    spring_force: &mut [Vec3],
     a: &mut [Vec3],
 ) {
-    model.accelerations(adjacency, &p.mass, &p.inv_mass, x, v, spring_force, a);
+    assembly.accelerations(model, (&p.mass, &p.inv_mass), x, v, a);
+}
+
+/// Per-particle updates in parallel blocks of [`BLOCK`] particles.
+fn for_blocks(
+    a: &mut [Vec3],
+    b: &mut [Vec3],
+    f: impl Fn(usize, &mut [Vec3], &mut [Vec3]) + Sync + Send,
+) {
+    parallel::for_blocks(BLOCK, a, b, f);
+}
+
+/// The trial state `(xt, vt) = (x + c·kx, v + c·kv)` of a multi-stage scheme.
+#[allow(clippy::too_many_arguments)]
+fn trial(
+    (x, v): (&[Vec3], &[Vec3]),
+    (kx, kv): (&[Vec3], &[Vec3]),
+    c: f64,
+    xt: &mut [Vec3],
+    vt: &mut [Vec3],
+) {
+    for_blocks(xt, vt, |start, xt, vt| {
+        for k in 0..xt.len() {
+            let i = start + k;
+            xt[k] = x[i] + kx[i] * c;
+            vt[k] = v[i] + kv[i] * c;
+        }
+    });
 }

@@ -1,50 +1,35 @@
 //! Classic fourth-order Runge–Kutta: `s' = s + dt/6 (k1 + 2 k2 + 2 k3 + k4)`.
 
-use super::{Workspace, accelerations};
+use super::{Workspace, accelerations, for_blocks, trial};
 use crate::model::Model;
 use crate::particles::Particles;
 
-#[allow(
-    clippy::needless_range_loop,
-    reason = "six arrays advance in lockstep; one index reads clearest"
-)]
 pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) {
     let half = 0.5 * dt;
-    let n = p.len();
     ws.x0.copy_from_slice(&p.x);
     // Stage 1 at the current state; its position derivative is the velocity itself.
     ws.kx[0].copy_from_slice(&p.v);
-    accelerations(
-        model,
-        &ws.adjacency,
-        p,
-        &p.x,
-        &p.v,
-        &mut ws.spring_force,
-        &mut ws.kv[0],
-    );
+    accelerations(model, &mut ws.assembly, p, &p.x, &p.v, &mut ws.kv[0]);
     // Stages 2..4 at s + c·dt·k_{stage-1}, with c = 1/2, 1/2, 1.
     for (stage, c) in [(1, half), (2, half), (3, dt)] {
-        for i in 0..n {
-            ws.xt[i] = p.x[i] + ws.kx[stage - 1][i] * c;
-            ws.vt[i] = p.v[i] + ws.kv[stage - 1][i] * c;
-        }
-        ws.kx[stage].copy_from_slice(&ws.vt);
-        accelerations(
-            model,
-            &ws.adjacency,
-            p,
-            &ws.xt,
-            &ws.vt,
-            &mut ws.spring_force,
-            &mut ws.kv[stage],
+        trial(
+            (&p.x, &p.v),
+            (&ws.kx[stage - 1], &ws.kv[stage - 1]),
+            c,
+            &mut ws.xt,
+            &mut ws.vt,
         );
+        ws.kx[stage].copy_from_slice(&ws.vt);
+        accelerations(model, &mut ws.assembly, p, &ws.xt, &ws.vt, &mut ws.kv[stage]);
     }
     let sixth = dt / 6.0;
     let [k1x, k2x, k3x, k4x] = &ws.kx;
     let [k1v, k2v, k3v, k4v] = &ws.kv;
-    for i in 0..n {
-        p.x[i] += (k1x[i] + k2x[i] * 2.0 + k3x[i] * 2.0 + k4x[i]) * sixth;
-        p.v[i] += (k1v[i] + k2v[i] * 2.0 + k3v[i] * 2.0 + k4v[i]) * sixth;
-    }
+    for_blocks(&mut p.x, &mut p.v, |start, x, v| {
+        for k in 0..x.len() {
+            let i = start + k;
+            x[k] += (k1x[i] + k2x[i] * 2.0 + k3x[i] * 2.0 + k4x[i]) * sixth;
+            v[k] += (k1v[i] + k2v[i] * 2.0 + k3v[i] * 2.0 + k4v[i]) * sixth;
+        }
+    });
 }
