@@ -33,7 +33,7 @@ pub struct View {
     pub supersample: u32,
 }
 
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once('x')
         .ok_or_else(|| format!("expected WIDTHxHEIGHT such as 800x600, found '{s}'"))?;

@@ -1,5 +1,6 @@
 //! `hooke`: run, render and inspect mass-spring scenes.
 
+mod bench;
 mod draw;
 mod image_out;
 mod output;
@@ -52,6 +53,9 @@ enum Command {
         #[command(flatten)]
         setup: SetupArgs,
     },
+    /// Benchmarks: the cloth-N solver workload and the rasterizer.
+    #[command(subcommand)]
+    Bench(bench::Bench),
     /// Convert between a jello world (.w) and a scene file (.toml), by the files' extensions.
     Convert {
         /// Input file (.w or .toml).
@@ -164,5 +168,6 @@ fn dispatch(command: Command) -> Result<ExitCode> {
         }
         Command::Check { scene, setup } => run::check(&scene, &setup),
         Command::Convert { input, output } => run::convert(&input, &output),
+        Command::Bench(bench) => bench::run(&bench),
     }
 }

@@ -1,17 +1,19 @@
 //! Force assembly: spring forces accumulated in fixed partitions, then reduced per particle
 //! in a fixed order.
 //!
-//! Springs are cut into partitions of [`PARTITION`] consecutive springs. Each partition
+//! Springs are sorted by their lower particle index (ties keep the model's order) and cut
+//! into partitions of [`PARTITION`] consecutive springs. Each partition
 //! scatters its forces into a private buffer covering only the particles it touches (its
 //! *window*); a second pass gives each particle the sum of its external force and of every
 //! window holding it, in partition order. Partitions and reduction blocks are fixed by the
 //! problem's size, never by the thread count, so the sums are the same bits on any number
-//! of threads, with no atomics. Springs listed in mesh order touch narrow windows, so the
-//! buffers add little memory beyond one force per particle.
+//! of threads, with no atomics. Sorted springs of a mesh touch narrow windows, so the
+//! buffers add little memory beyond one force per particle, and each partition reads
+//! positions from a small, cache-resident stretch of the arrays.
 
 use crate::model::Model;
 use crate::particles::Vec3;
-use crate::spring::{Spring, spring_force};
+use crate::spring::{Lanes, Spring, spring_lanes};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::ops::Range;
@@ -25,13 +27,53 @@ pub const BLOCK: usize = 1 << 12;
 
 /// The springs of a model in the solver's layout: end pairs, rest lengths and an index into
 /// a table of distinct `(ks, kd)` pairs, one array each, so the hot loop streams 20 bytes per
-/// spring instead of the 40 of [`Spring`].
+/// spring instead of the 40 of [`Spring`] (16 when all springs share one `(ks, kd)`, and
+/// `param` is left empty).
 #[derive(Clone, Debug, Default)]
 struct SpringTable {
     ends: Vec<[u32; 2]>,
     rest: Vec<f64>,
     param: Vec<u32>,
     params: Vec<[f64; 2]>,
+}
+
+/// Springs computed side by side in the force loop.
+const LANES: usize = 2;
+
+impl SpringTable {
+    /// The forces of springs `k..k + L` on their lower ends.
+    #[inline(always)]
+    fn lanes<const L: usize>(&self, k: usize, x: &[Vec3], v: &[Vec3]) -> [[f64; 3]; L] {
+        let mut s = Lanes {
+            d: [[0.0; L]; 3],
+            dv: [[0.0; L]; 3],
+            rest: [0.0; L],
+            ks: [0.0; L],
+            kd: [0.0; L],
+        };
+        for l in 0..L {
+            let [i, j] = self.ends[k + l];
+            let (i, j) = (i as usize, j as usize);
+            let (d, dv) = (x[i] - x[j], v[i] - v[j]);
+            for c in 0..3 {
+                s.d[c][l] = d[c];
+                s.dv[c][l] = dv[c];
+            }
+            s.rest[l] = self.rest[k + l];
+            [s.ks[l], s.kd[l]] = self.params(k + l);
+        }
+        let f = spring_lanes(&s);
+        std::array::from_fn(|l| [f[0][l], f[1][l], f[2][l]])
+    }
+
+    #[inline]
+    fn params(&self, k: usize) -> [f64; 2] {
+        if self.param.is_empty() {
+            self.params[0]
+        } else {
+            self.params[self.param[k] as usize]
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -63,8 +105,6 @@ impl Assembly {
     /// If a spring names a particle that does not exist (a builder bug, not user input: scene
     /// loaders validate indices first).
     pub fn new(particles: usize, springs: &[Spring]) -> Self {
-        let mut table = SpringTable::default();
-        let mut seen: HashMap<[u64; 2], u32> = HashMap::new();
         for (k, s) in springs.iter().enumerate() {
             assert!(
                 (s.i as usize) < particles && (s.j as usize) < particles,
@@ -72,7 +112,18 @@ impl Assembly {
                 s.i,
                 s.j
             );
-            table.ends.push([s.i, s.j]);
+        }
+        let mut order: Vec<u32> = (0..springs.len() as u32).collect();
+        order.sort_by_key(|&k| {
+            let s = &springs[k as usize];
+            (s.i.min(s.j), s.i.max(s.j))
+        });
+        let mut table = SpringTable::default();
+        let mut seen: HashMap<[u64; 2], u32> = HashMap::new();
+        for &k in &order {
+            let s = &springs[k as usize];
+            // Lower index first: the force on the other end is the exact negation.
+            table.ends.push([s.i.min(s.j), s.i.max(s.j)]);
             table.rest.push(s.rest);
             let key = [s.ks.to_bits(), s.kd.to_bits()];
             let next = table.params.len() as u32;
@@ -81,6 +132,9 @@ impl Assembly {
                 table.params.push([s.ks, s.kd]);
             }
             table.param.push(index);
+        }
+        if table.params.len() == 1 {
+            table.param = Vec::new();
         }
         let partitions: Vec<Partition> = (0..springs.len())
             .step_by(PARTITION)
@@ -122,6 +176,73 @@ impl Assembly {
         self.particles == particles && self.table.ends.len() == springs
     }
 
+    /// Computes every spring's force at `(x, v)` into the partition buffers.
+    pub fn scatter(&mut self, x: &[Vec3], v: &[Vec3]) {
+        let table = &self.table;
+        let scatter = |part: &mut Partition| {
+            part.force.fill(Vec3::zeros());
+            let lo = part.lo;
+            // Springs sharing a lower end are consecutive: sum their pull on it in a register
+            // and store once, instead of a store-to-load chain through memory per spring.
+            let mut current = part.lo;
+            let mut pull = Vec3::zeros();
+            let mut add = |k: usize, f: [f64; 3]| {
+                let [i, j] = table.ends[k];
+                let (i, j) = (i as usize, j as usize);
+                if i != current {
+                    part.force[current - lo] += pull;
+                    pull = Vec3::zeros();
+                    current = i;
+                }
+                let f = Vec3::new(f[0], f[1], f[2]);
+                pull += f;
+                part.force[j - lo] -= f;
+            };
+            // Springs in batches of LANES, computed side by side so the compiler can use
+            // vector instructions and overlap their square roots and divisions.
+            let springs = part.springs.clone();
+            let mut k = springs.start;
+            while k + LANES <= springs.end {
+                for (l, f) in table.lanes::<LANES>(k, x, v).into_iter().enumerate() {
+                    add(k + l, f);
+                }
+                k += LANES;
+            }
+            for k in k..springs.end {
+                add(k, table.lanes::<1>(k, x, v)[0]);
+            }
+            part.force[current - lo] += pull;
+        };
+        if self.partitions.len() == 1 {
+            scatter(&mut self.partitions[0]);
+        } else {
+            self.partitions.par_iter_mut().for_each(scatter);
+        }
+    }
+
+    /// The total spring force on particle `p` from the last [`Assembly::scatter`].
+    #[inline]
+    pub fn spring_force(&self, p: usize) -> Vec3 {
+        let b = p / BLOCK;
+        let parts =
+            &self.block_parts[self.block_start[b] as usize..self.block_start[b + 1] as usize];
+        let mut f = Vec3::zeros();
+        for &q in parts {
+            let part = &self.partitions[q as usize];
+            if let Some(g) = p.checked_sub(part.lo).and_then(|w| part.force.get(w)) {
+                f += g;
+            }
+        }
+        f
+    }
+
+    /// The total force on particle `p`: external forces plus springs (after a scatter at the
+    /// same `(x, v)`).
+    #[inline]
+    pub fn force(&self, model: &Model, mass: f64, x: &Vec3, v: &Vec3, p: usize) -> Vec3 {
+        model.external_force(mass, x, v) + self.spring_force(p)
+    }
+
     /// `a = F(x, v) / m` for every particle; pinned particles get zero.
     pub fn accelerations(
         &mut self,
@@ -131,49 +252,23 @@ impl Assembly {
         v: &[Vec3],
         a: &mut [Vec3],
     ) {
-        let table = &self.table;
-        let scatter = |part: &mut Partition| {
-            part.force.fill(Vec3::zeros());
-            let lo = part.lo;
-            for k in part.springs.clone() {
-                let [i, j] = table.ends[k];
-                let (i, j) = (i as usize, j as usize);
-                let [ks, kd] = table.params[table.param[k] as usize];
-                let f = spring_force(x[i] - x[j], v[i] - v[j], table.rest[k], ks, kd);
-                part.force[i - lo] += f;
-                part.force[j - lo] -= f;
-            }
-        };
-        if self.partitions.len() == 1 {
-            scatter(&mut self.partitions[0]);
-        } else {
-            self.partitions.par_iter_mut().for_each(scatter);
-        }
-
-        let partitions = &self.partitions;
-        let (block_start, block_parts) = (&self.block_start, &self.block_parts);
-        let gather = |(b, a): (usize, &mut [Vec3])| {
-            let parts = &block_parts[block_start[b] as usize..block_start[b + 1] as usize];
+        self.scatter(x, v);
+        let gather = |start: usize, a: &mut [Vec3]| {
             for (k, out) in a.iter_mut().enumerate() {
-                let p = b * BLOCK + k;
-                if inv_mass[p] == 0.0 {
-                    *out = Vec3::zeros();
-                    continue;
-                }
-                let mut f = model.external_force(mass[p], &x[p], &v[p]);
-                for &q in parts {
-                    let part = &partitions[q as usize];
-                    if let Some(g) = p.checked_sub(part.lo).and_then(|w| part.force.get(w)) {
-                        f += g;
-                    }
-                }
-                *out = f / mass[p];
+                let p = start + k;
+                *out = if inv_mass[p] == 0.0 {
+                    Vec3::zeros()
+                } else {
+                    self.force(model, mass[p], &x[p], &v[p], p) * inv_mass[p]
+                };
             }
         };
         if a.len() <= BLOCK {
-            gather((0, a));
+            gather(0, a);
         } else {
-            a.par_chunks_mut(BLOCK).enumerate().for_each(gather);
+            a.par_chunks_mut(BLOCK)
+                .enumerate()
+                .for_each(|(b, a)| gather(b * BLOCK, a));
         }
     }
 }

@@ -43,10 +43,10 @@ mod spring;
 mod stability;
 mod summary;
 
+pub use assembly::Assembly;
 pub use collider::{Collider, Contact};
 pub use force_field::{FIELD_HALF_EXTENT, ForceField};
 pub use integrator::{Integrator, UnknownIntegrator, Workspace};
-pub use assembly::Assembly;
 pub use model::{ColliderSlot, Model};
 pub use particles::{Particles, Vec3};
 pub use response::Response;

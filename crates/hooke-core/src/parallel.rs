@@ -25,3 +25,46 @@ pub(crate) fn for_blocks(
             .for_each(|(k, (a, b))| f(k * block, a, b));
     }
 }
+
+/// Particles per block when scanning for the first bad particle.
+const SCAN_BLOCK: usize = 1 << 14;
+
+/// The result of `f` for the lowest index `i < n` where it is `Some`: the same answer as a
+/// sequential scan, found in parallel for large `n`.
+pub(crate) fn find_first<T: Send>(
+    n: usize,
+    f: impl Fn(usize) -> Option<T> + Sync + Send,
+) -> Option<T> {
+    if n <= SCAN_BLOCK {
+        (0..n).find_map(f)
+    } else {
+        (0..n)
+            .into_par_iter()
+            .with_min_len(SCAN_BLOCK)
+            .find_map_first(f)
+    }
+}
+
+/// Whether every position component is within `bound` (so finite) and every velocity is
+/// finite: a branch-free scan the compiler vectorises, run on every step.
+pub(crate) fn all_sane(x: &[Vec3], v: &[Vec3], bound: f64) -> bool {
+    // And-ing comparison results (not max, which skips NaN) keeps the loop branch-free and
+    // vectorised; NaN fails every comparison, so it counts as out of bounds.
+    let block = |x: &[Vec3], v: &[Vec3]| {
+        let mut ok = true;
+        for p in x {
+            ok &= (p.x.abs() <= bound) & (p.y.abs() <= bound) & (p.z.abs() <= bound);
+        }
+        for p in v {
+            ok &= p.x.is_finite() & p.y.is_finite() & p.z.is_finite();
+        }
+        ok
+    };
+    if x.len() <= SCAN_BLOCK {
+        block(x, v)
+    } else {
+        x.par_chunks(SCAN_BLOCK)
+            .zip(v.par_chunks(SCAN_BLOCK))
+            .all(|(x, v)| block(x, v))
+    }
+}

@@ -2,6 +2,7 @@
 
 use crate::integrator::{Integrator, Workspace};
 use crate::model::Model;
+use crate::parallel;
 use crate::particles::{Particles, Vec3};
 use crate::stability::StabilityEstimate;
 
@@ -133,7 +134,11 @@ impl Simulation {
 
     fn check(&self) -> Result<(), Divergence> {
         let p = &self.particles;
-        let bad = p.x.iter().zip(&p.v).enumerate().find_map(|(i, (x, v))| {
+        if parallel::all_sane(&p.x, &p.v, SANE_BOUND) {
+            return Ok(());
+        }
+        let bad = parallel::find_first(p.len(), |i| {
+            let (x, v) = (&p.x[i], &p.v[i]);
             if !(x.iter().all(|c| c.is_finite()) && v.iter().all(|c| c.is_finite())) {
                 Some((i, "is not finite".to_string()))
             } else if x.amax() > SANE_BOUND {

@@ -74,14 +74,60 @@ impl Spring {
 }
 
 /// The force on the `i` end of a spring from `d = x_i - x_j` and `dv = v_i - v_j` (SPEC §1):
-/// `(-ks (|d| - rest) - kd dv·u) u` with `u = d / |d|`; zero for a degenerate spring. The one
-/// formula every force path uses, so they agree to the bit.
+/// `(-ks (|d| - rest) - kd dv·u) u` with `u = d / |d|`; zero for a degenerate spring. Every
+/// force path goes through [`spring_lanes`], so they agree to the bit.
 #[inline]
 pub(crate) fn spring_force(d: Vec3, dv: Vec3, rest: f64, ks: f64, kd: f64) -> Vec3 {
-    let len = d.norm();
-    if len < DEGENERATE_LENGTH {
-        return Vec3::zeros();
-    }
-    let u = d / len;
-    u * (-ks * (len - rest) - kd * dv.dot(&u))
+    let f = spring_lanes(&Lanes {
+        d: [[d.x], [d.y], [d.z]],
+        dv: [[dv.x], [dv.y], [dv.z]],
+        rest: [rest],
+        ks: [ks],
+        kd: [kd],
+    });
+    Vec3::new(f[0][0], f[1][0], f[2][0])
+}
+
+/// `L` springs' inputs, one array per component, for [`spring_lanes`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Lanes<const L: usize> {
+    pub d: [[f64; L]; 3],
+    pub dv: [[f64; L]; 3],
+    pub rest: [f64; L],
+    pub ks: [f64; L],
+    pub kd: [f64; L],
+}
+
+/// [`spring_force`] for `L` springs side by side, component arrays in and out, without
+/// branches: each step is a loop over lanes that compiles to vector instructions, and the
+/// square roots and divisions of different springs overlap.
+#[inline(always)]
+pub(crate) fn spring_lanes<const L: usize>(s: &Lanes<L>) -> [[f64; L]; 3] {
+    let [dx, dy, dz] = &s.d;
+    let [vx, vy, vz] = &s.dv;
+    let len: [f64; L] =
+        std::array::from_fn(|l| (dx[l] * dx[l] + dy[l] * dy[l] + dz[l] * dz[l]).sqrt());
+    // One division instead of three: the reciprocal scales all components.
+    // A degenerate spring gets a zero direction, hence zero force, never 0·∞ = NaN.
+    let inv: [f64; L] = std::array::from_fn(|l| {
+        if len[l] < DEGENERATE_LENGTH {
+            0.0
+        } else {
+            1.0 / len[l]
+        }
+    });
+    let u: [[f64; L]; 3] = [
+        std::array::from_fn(|l| dx[l] * inv[l]),
+        std::array::from_fn(|l| dy[l] * inv[l]),
+        std::array::from_fn(|l| dz[l] * inv[l]),
+    ];
+    let scale: [f64; L] = std::array::from_fn(|l| {
+        -s.ks[l] * (len[l] - s.rest[l])
+            - s.kd[l] * (vx[l] * u[0][l] + vy[l] * u[1][l] + vz[l] * u[2][l])
+    });
+    [
+        std::array::from_fn(|l| u[0][l] * scale[l]),
+        std::array::from_fn(|l| u[1][l] * scale[l]),
+        std::array::from_fn(|l| u[2][l] * scale[l]),
+    ]
 }

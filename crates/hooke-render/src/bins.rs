@@ -46,6 +46,7 @@ impl Grid {
     }
 }
 
+#[derive(Default)]
 struct Chunk {
     /// `start[t]..start[t + 1]` indexes `items` for tile `t`.
     start: Vec<u32>,
@@ -53,20 +54,35 @@ struct Chunk {
 }
 
 /// For every tile, the indices of the primitives whose rectangle touches it, in order.
+/// Refilled every frame, reusing its memory.
+#[derive(Default)]
 pub(crate) struct Bins {
     chunks: Vec<Chunk>,
 }
 
 impl Bins {
-    pub fn new<T: Sync>(items: &[T], rect: impl Fn(&T) -> Rect + Sync, grid: &Grid) -> Self {
+    /// Bins `items` (`None` for primitives that were culled) into the tiles of `grid`.
+    pub fn fill<T: Sync>(
+        &mut self,
+        items: &[Option<T>],
+        rect: impl Fn(&T) -> Rect + Sync,
+        grid: &Grid,
+    ) {
         let tiles = grid.count();
-        let chunks = items
-            .par_chunks(CHUNK)
+        self.chunks
+            .resize_with(items.len().div_ceil(CHUNK), Chunk::default);
+        self.chunks
+            .par_iter_mut()
+            .zip(items.par_chunks(CHUNK))
             .enumerate()
-            .map(|(c, chunk)| {
-                let mut start = vec![0u32; tiles + 1];
-                for item in chunk {
-                    let (x0, y0, x1, y1) = grid.span(&rect(item));
+            .for_each(|(c, (bin, chunk))| {
+                let start = &mut bin.start;
+                start.clear();
+                start.resize(tiles + 1, 0);
+                let spans = chunk.iter().enumerate().filter_map(|(k, item)| {
+                    Some(((c * CHUNK + k) as u32, grid.span(&rect(item.as_ref()?))))
+                });
+                for (_, (x0, y0, x1, y1)) in spans.clone() {
                     for ty in y0..=y1 {
                         for tx in x0..=x1 {
                             start[(ty * grid.across + tx) as usize + 1] += 1;
@@ -76,23 +92,23 @@ impl Bins {
                 for t in 0..tiles {
                     start[t + 1] += start[t];
                 }
-                let mut fill = start.clone();
-                let mut items = vec![0u32; start[tiles] as usize];
-                for (k, item) in chunk.iter().enumerate() {
-                    let index = (c * CHUNK + k) as u32;
-                    let (x0, y0, x1, y1) = grid.span(&rect(item));
+                bin.items.clear();
+                bin.items.resize(start[tiles] as usize, 0);
+                // Fill by advancing each tile's start, then shift the starts back.
+                for (index, (x0, y0, x1, y1)) in spans {
                     for ty in y0..=y1 {
                         for tx in x0..=x1 {
-                            let slot = &mut fill[(ty * grid.across + tx) as usize];
-                            items[*slot as usize] = index;
+                            let slot = &mut start[(ty * grid.across + tx) as usize];
+                            bin.items[*slot as usize] = index;
                             *slot += 1;
                         }
                     }
                 }
-                Chunk { start, items }
-            })
-            .collect();
-        Self { chunks }
+                for t in (0..tiles).rev() {
+                    start[t + 1] = start[t];
+                }
+                start[0] = 0;
+            });
     }
 
     /// The primitives touching tile `t`, in draw-list order.

@@ -18,9 +18,9 @@
 //! assert!(centre[0] > centre[1] + 50, "the red triangle covers the centre: {centre:?}");
 //! ```
 
+mod bins;
 mod camera;
 mod draw_list;
-mod bins;
 mod raster;
 mod setup;
 mod shading;
@@ -28,4 +28,4 @@ mod tile;
 
 pub use camera::Camera;
 pub use draw_list::{DrawList, Line, Point, Rgb, Triangle};
-pub use raster::{RenderOptions, render};
+pub use raster::{RenderOptions, Renderer, render};

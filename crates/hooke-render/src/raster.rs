@@ -16,6 +16,7 @@ use crate::draw_list::{DrawList, Rgb};
 use crate::setup::{Frame, LineSetup, PointSetup, Rect, TriSetup};
 use crate::shading::Shading;
 use crate::tile::{EMPTY, Samples};
+use nalgebra::Vector3;
 use rayon::prelude::*;
 
 /// How to render.
@@ -49,34 +50,45 @@ pub const TILE: u32 = 64;
 /// Everything the resolve needs to shade a sample's primitive.
 struct Prepared<'a> {
     list: &'a DrawList,
-    tris: Vec<TriSetup>,
-    lines: Vec<LineSetup>,
-    points: Vec<PointSetup>,
+    tris: &'a [Option<TriSetup>],
+    lines: &'a [Option<LineSetup>],
+    points: &'a [Option<PointSetup>],
     shading: Shading,
     options: &'a RenderOptions,
     ss: u32,
 }
 
+/// What a primitive shows at one point.
+enum Surface {
+    /// An unlit colour: background and lines.
+    Flat(Rgb),
+    /// A base colour lit with a normal.
+    Lit(Vector3<f64>, Rgb),
+}
+
 impl Prepared<'_> {
-    /// The colour of primitive `id` at the sample-space point `p`.
-    fn shade(&self, id: u32, p: (f64, f64)) -> Rgb {
+    /// What primitive `id` shows at the sample-space point `p`.
+    fn surface(&self, id: u32, p: (f64, f64)) -> Surface {
         let id = id as usize;
         let (nt, nl) = (self.tris.len(), self.lines.len());
         if id < nt {
-            let s = &self.tris[id];
+            let Some(s) = &self.tris[id] else {
+                return Surface::Flat([0.0; 3]);
+            };
             let t = &self.list.triangles[s.src as usize];
             let w = s.weights(p);
-            self.shading
-                .shade(t.n[0] * w[0] + t.n[1] * w[1] + t.n[2] * w[2], t.color)
+            Surface::Lit(t.n[0] * w[0] + t.n[1] * w[1] + t.n[2] * w[2], t.color)
         } else if id < nt + nl {
-            self.lines[id - nt].color
+            Surface::Flat(self.lines[id - nt].map_or([0.0; 3], |l| l.color))
         } else {
-            let s = &self.points[id - nt - nl];
+            let Some(s) = &self.points[id - nt - nl] else {
+                return Surface::Flat([0.0; 3]);
+            };
             let (u, v) = ((p.0 - s.c.0) / s.radius, (s.c.1 - p.1) / s.radius);
             let r2 = (u * u + v * v).min(1.0);
             let n = self.shading.right * u + self.shading.up * v
                 - self.shading.forward * (1.0 - r2).sqrt();
-            self.shading.shade(n, s.color)
+            Surface::Lit(n, s.color)
         }
     }
 
@@ -87,23 +99,30 @@ impl Prepared<'_> {
     }
 
     /// Shades and averages the tile's samples into RGBA8 pixels, row-major over the tile.
-    fn resolve(&self, s: &Samples) -> Vec<u8> {
+    fn resolve(&self, s: &Samples, out: &mut Vec<u8>) {
         let ss = self.ss;
         let (px0, py0) = (s.area.x0 / ss, s.area.y0 / ss);
         let (w, h) = ((s.area.x1 - s.area.x0) / ss, (s.area.y1 - s.area.y0) / ss);
-        let n = (ss * ss) as f32;
-        let mut out = vec![0u8; (w * h * 4) as usize];
-        let mut ids: Vec<(u32, u32)> = Vec::with_capacity((ss * ss) as usize);
+        let weight = 1.0 / (ss * ss) as f32;
+        out.clear();
+        out.resize((w * h * 4) as usize, 0);
+        // Distinct primitives of one pixel and their sample counts (at most 16 samples).
+        let mut ids = [(0u32, 0u32); 16];
         for y in 0..h {
             let background = self.background(py0 + y);
+            let row = s.index(s.area.x0, s.area.y0 + y * ss);
             for x in 0..w {
-                ids.clear();
-                for sy in 0..ss {
-                    for sx in 0..ss {
-                        let id = s.id[s.index(s.area.x0 + x * ss + sx, s.area.y0 + y * ss + sy)];
-                        match ids.iter_mut().find(|(i, _)| *i == id) {
+                let first = row + (x * ss) as usize;
+                let mut distinct = 0;
+                for sy in 0..ss as usize {
+                    for sx in 0..ss as usize {
+                        let id = s.id[first + sy * s.stride + sx];
+                        match ids[..distinct].iter_mut().find(|(i, _)| *i == id) {
                             Some((_, count)) => *count += 1,
-                            None => ids.push((id, 1)),
+                            None => {
+                                ids[distinct] = (id, 1);
+                                distinct += 1;
+                            }
                         }
                     }
                 }
@@ -111,70 +130,138 @@ impl Prepared<'_> {
                     ((px0 + x) * ss) as f64 + ss as f64 * 0.5,
                     ((py0 + y) * ss) as f64 + ss as f64 * 0.5,
                 );
-                let mut sum = [0.0f32; 3];
-                for &(id, count) in &ids {
-                    let c = if id == EMPTY {
-                        background
-                    } else {
-                        self.shade(id, centre)
-                    };
-                    for k in 0..3 {
-                        sum[k] += c[k] * count as f32;
+                let c = if distinct == 1 && ids[0].0 == EMPTY {
+                    background
+                } else if distinct == 1 {
+                    match self.surface(ids[0].0, centre) {
+                        Surface::Flat(c) => c,
+                        Surface::Lit(n, c) => self.shading.shade(n, c),
                     }
-                }
+                } else {
+                    // Samples of one base colour are lit once with their summed normals:
+                    // where a smooth mesh's triangles are pixel-sized, a pixel shades once
+                    // per material rather than once per triangle, and looks the same.
+                    let mut sum = [0.0f32; 3];
+                    let mut lit: [(Rgb, Vector3<f64>, u32); 16] =
+                        [([0.0; 3], Vector3::zeros(), 0); 16];
+                    let mut materials = 0;
+                    for &(id, count) in &ids[..distinct] {
+                        let surface = if id == EMPTY {
+                            Surface::Flat(background)
+                        } else {
+                            self.surface(id, centre)
+                        };
+                        match surface {
+                            Surface::Flat(c) => {
+                                for k in 0..3 {
+                                    sum[k] += c[k] * count as f32;
+                                }
+                            }
+                            Surface::Lit(n, c) => {
+                                match lit[..materials].iter_mut().find(|m| m.0 == c) {
+                                    Some(m) => {
+                                        m.1 += n * count as f64;
+                                        m.2 += count;
+                                    }
+                                    None => {
+                                        lit[materials] = (c, n * count as f64, count);
+                                        materials += 1;
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    for (c, n, count) in &lit[..materials] {
+                        let c = self.shading.shade(*n, *c);
+                        for k in 0..3 {
+                            sum[k] += c[k] * *count as f32;
+                        }
+                    }
+                    sum.map(|v| v * weight)
+                };
                 let o = ((y * w + x) * 4) as usize;
                 for k in 0..3 {
-                    out[o + k] = (sum[k] / n * 255.0).round().clamp(0.0, 255.0) as u8;
+                    // Truncating `v + 0.5` rounds: `f32::round` is a libm call per channel.
+                    out[o + k] = (c[k].clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
                 }
                 out[o + 3] = 255;
             }
         }
-        out
     }
 }
 
 /// Renders `list` seen by `camera` into an RGBA8 image of `width × height` pixels, row-major.
+///
+/// A one-off: [`Renderer`] keeps its buffers from frame to frame.
 pub fn render(list: &DrawList, camera: &Camera, options: &RenderOptions) -> Vec<u8> {
-    let ss = options.supersample.max(1);
-    let (w, h) = (options.width * ss, options.height * ss);
-    let frame = Frame::new(camera, w, h);
-    let per_pixel = ss as f64;
-    let tris: Vec<TriSetup> = list
-        .triangles
-        .par_iter()
-        .enumerate()
-        .filter_map(|(i, t)| TriSetup::new(&frame, t, i as u32))
-        .collect();
-    let lines: Vec<LineSetup> = list
-        .lines
-        .par_iter()
-        .filter_map(|l| LineSetup::new(&frame, l, per_pixel))
-        .collect();
-    let points: Vec<PointSetup> = list
-        .points
-        .par_iter()
-        .filter_map(|p| PointSetup::new(&frame, p, per_pixel))
-        .collect();
-    let grid = Grid::new(w, h, TILE * ss);
-    let tri_bins = Bins::new(&tris, |t| t.rect, &grid);
-    let line_bins = Bins::new(&lines, |l| l.rect, &grid);
-    let point_bins = Bins::new(&points, |p| p.rect, &grid);
-    let prepared = Prepared {
-        list,
-        tris,
-        lines,
-        points,
-        shading: Shading::new(camera),
-        options,
-        ss,
-    };
-    let (nt, nl) = (prepared.tris.len() as u32, prepared.lines.len() as u32);
+    Renderer::default().render(list, camera, options)
+}
 
-    let tiles: Vec<Vec<u8>> = (0..grid.count())
-        .into_par_iter()
-        .map_init(
+/// A rasterizer that keeps its per-primitive buffers between frames, so an animation or a
+/// viewer does not allocate (and the kernel does not zero) hundreds of megabytes per frame.
+#[derive(Default)]
+pub struct Renderer {
+    /// Set-up primitives by draw-list index; `None` where culled.
+    tris: Vec<Option<TriSetup>>,
+    lines: Vec<Option<LineSetup>>,
+    points: Vec<Option<PointSetup>>,
+    tri_bins: Bins,
+    line_bins: Bins,
+    point_bins: Bins,
+    /// Each tile's resolved pixels.
+    tiles: Vec<Vec<u8>>,
+}
+
+/// Sets up every primitive of `list` into `out` (same length, reusing its memory).
+fn set_up<P: Sync, S: Send>(
+    out: &mut Vec<Option<S>>,
+    list: &[P],
+    f: impl Fn(usize, &P) -> Option<S> + Sync,
+) {
+    out.resize_with(list.len(), || None);
+    out.par_iter_mut()
+        .zip(list.par_iter())
+        .enumerate()
+        .for_each(|(i, (slot, p))| *slot = f(i, p));
+}
+
+impl Renderer {
+    /// Renders `list` seen by `camera` into an RGBA8 image of `width × height` pixels,
+    /// row-major. The pixels depend only on the arguments, never on earlier frames.
+    pub fn render(&mut self, list: &DrawList, camera: &Camera, options: &RenderOptions) -> Vec<u8> {
+        let ss = options.supersample.max(1);
+        let (w, h) = (options.width * ss, options.height * ss);
+        let frame = Frame::new(camera, w, h);
+        let per_pixel = ss as f64;
+        set_up(&mut self.tris, &list.triangles, |i, t| {
+            TriSetup::new(&frame, t, i as u32)
+        });
+        set_up(&mut self.lines, &list.lines, |_, l| {
+            LineSetup::new(&frame, l, per_pixel)
+        });
+        set_up(&mut self.points, &list.points, |_, p| {
+            PointSetup::new(&frame, p, per_pixel)
+        });
+        let grid = Grid::new(w, h, TILE * ss);
+        self.tri_bins.fill(&self.tris, |t| t.rect, &grid);
+        self.line_bins.fill(&self.lines, |l| l.rect, &grid);
+        self.point_bins.fill(&self.points, |p| p.rect, &grid);
+        let prepared = Prepared {
+            list,
+            tris: &self.tris,
+            lines: &self.lines,
+            points: &self.points,
+            shading: Shading::new(camera),
+            options,
+            ss,
+        };
+        let (nt, nl) = (self.tris.len() as u32, self.lines.len() as u32);
+        let (tri_bins, line_bins, point_bins) = (&self.tri_bins, &self.line_bins, &self.point_bins);
+
+        self.tiles.resize_with(grid.count(), Vec::new);
+        self.tiles.par_iter_mut().enumerate().for_each_init(
             || Samples::new(grid.side),
-            |samples, t| {
+            |samples, (t, pixels)| {
                 let (tx, ty) = (t as u32 % grid.across, t as u32 / grid.across);
                 samples.reset(Rect {
                     x0: tx * grid.side,
@@ -182,38 +269,44 @@ pub fn render(list: &DrawList, camera: &Camera, options: &RenderOptions) -> Vec<
                     x1: ((tx + 1) * grid.side).min(w),
                     y1: ((ty + 1) * grid.side).min(h),
                 });
+                // Binned primitives are the set-up ones: the `if let` never skips.
                 for id in tri_bins.tile(t) {
-                    samples.triangle(&prepared.tris[id as usize], id);
+                    if let Some(s) = &prepared.tris[id as usize] {
+                        samples.triangle(s, id);
+                    }
                 }
                 for id in line_bins.tile(t) {
-                    samples.line(&prepared.lines[id as usize], nt + id);
+                    if let Some(s) = &prepared.lines[id as usize] {
+                        samples.line(s, nt + id);
+                    }
                 }
                 for id in point_bins.tile(t) {
-                    samples.point(&prepared.points[id as usize], nt + nl + id);
+                    if let Some(s) = &prepared.points[id as usize] {
+                        samples.point(s, nt + nl + id);
+                    }
                 }
-                prepared.resolve(samples)
+                prepared.resolve(samples, pixels);
             },
-        )
-        .collect();
+        );
 
-    let (width, tile) = (options.width as usize, TILE as usize);
-    let mut out = vec![0u8; width * options.height as usize * 4];
-    for (t, pixels) in tiles.iter().enumerate() {
-        let (tx, ty) = (t % grid.across as usize, t / grid.across as usize);
-        let tile_width = tile.min(width - tx * tile);
-        for (r, row) in pixels.chunks(tile_width * 4).enumerate() {
-            let start = ((ty * tile + r) * width + tx * tile) * 4;
-            out[start..start + row.len()].copy_from_slice(row);
+        let (width, tile) = (options.width as usize, TILE as usize);
+        let mut out = vec![0u8; width * options.height as usize * 4];
+        for (t, pixels) in self.tiles.iter().enumerate() {
+            let (tx, ty) = (t % grid.across as usize, t / grid.across as usize);
+            let tile_width = tile.min(width - tx * tile);
+            for (r, row) in pixels.chunks(tile_width * 4).enumerate() {
+                let start = ((ty * tile + r) * width + tx * tile) * 4;
+                out[start..start + row.len()].copy_from_slice(row);
+            }
         }
+        out
     }
-    out
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::draw_list::{Line, Point};
-    use nalgebra::Vector3;
 
     fn scene() -> DrawList {
         let mut list = DrawList::default();

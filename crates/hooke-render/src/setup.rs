@@ -52,7 +52,7 @@ impl Frame {
     /// `None` when the point is closer than the near plane (or behind the eye).
     fn project(&self, p: &Vector3<f64>) -> Option<Projected> {
         let c = self.m * Vector4::new(p.x, p.y, p.z, 1.0);
-        if !(c.w >= self.near) {
+        if c.w.is_nan() || c.w < self.near {
             return None;
         }
         let inv_w = 1.0 / c.w;
@@ -70,6 +70,24 @@ impl Frame {
         let last = |v: f64, n: u32| (v - 0.5).floor().min(n as f64 - 1.0);
         let (x0, x1) = (first(lo.0), last(hi.0, self.width));
         let (y0, y1) = (first(lo.1), last(hi.1, self.height));
+        (x0 <= x1 && y0 <= y1).then(|| Rect {
+            x0: x0 as u32,
+            y0: y0 as u32,
+            x1: x1 as u32 + 1,
+            y1: y1 as u32 + 1,
+        })
+    }
+}
+
+impl Frame {
+    /// The sample centres within the fixed-point box `[min, max]`, in integer arithmetic.
+    fn fixed_rect(&self, min: [i64; 2], max: [i64; 2]) -> Option<Rect> {
+        // Sample i's centre is at i·SUB + SUB/2: the first at or after `lo`, the last at or
+        // before `hi`.
+        let first = |lo: i64| (lo - SUB / 2 + SUB - 1).div_euclid(SUB).max(0);
+        let last = |hi: i64, n: u32| (hi - SUB / 2).div_euclid(SUB).min(n as i64 - 1);
+        let (x0, x1) = (first(min[0]), last(max[0], self.width));
+        let (y0, y1) = (first(min[1]), last(max[1], self.height));
         (x0 <= x1 && y0 <= y1).then(|| Rect {
             x0: x0 as u32,
             y0: y0 as u32,
@@ -113,12 +131,11 @@ impl TriSetup {
         if p.iter().any(|q| q.x.abs() > GUARD || q.y.abs() > GUARD) {
             return None;
         }
-        let fixed = |q: &Projected| {
-            [
-                (q.x * SUB as f64).round() as i64,
-                (q.y * SUB as f64).round() as i64,
-            ]
-        };
+        // Round to nearest by truncating a positive number: the guard band keeps
+        // `v·SUB + BIAS` positive, and `as` truncation avoids a libm call per coordinate.
+        const BIAS: f64 = (1u64 << 40) as f64;
+        let round = |v: f64| (v * SUB as f64 + (BIAS + 0.5)) as i64 - BIAS as i64;
+        let fixed = |q: &Projected| [round(q.x), round(q.y)];
         let mut v = p.each_ref().map(fixed);
         let mut z = p.map(|q| q.z as f32);
         let mut inv_w = p.map(|q| q.inv_w as f32);
@@ -133,15 +150,11 @@ impl TriSetup {
             inv_w.swap(1, 2);
             area = -area;
         }
-        let s = SUB as f64;
-        let lo = (
-            v.iter().map(|c| c[0]).min()? as f64 / s,
-            v.iter().map(|c| c[1]).min()? as f64 / s,
+        let (min, max) = (
+            [0, 1].map(|a| v.iter().map(|c| c[a]).min().unwrap_or(0)),
+            [0, 1].map(|a| v.iter().map(|c| c[a]).max().unwrap_or(0)),
         );
-        let hi = (
-            v.iter().map(|c| c[0]).max()? as f64 / s,
-            v.iter().map(|c| c[1]).max()? as f64 / s,
-        );
+        let rect = frame.fixed_rect(min, max)?;
         Some(Self {
             v,
             z,
@@ -149,7 +162,7 @@ impl TriSetup {
             area,
             src,
             swapped,
-            rect: frame.rect(lo, hi)?,
+            rect,
         })
     }
 
@@ -158,7 +171,8 @@ impl TriSetup {
     pub fn weights(&self, p: (f64, f64)) -> [f64; 3] {
         let s = SUB as f64;
         let v = self.v.map(|c| (c[0] as f64 / s, c[1] as f64 / s));
-        let e = |a: (f64, f64), b: (f64, f64)| (b.0 - a.0) * (p.1 - a.1) - (b.1 - a.1) * (p.0 - a.0);
+        let e =
+            |a: (f64, f64), b: (f64, f64)| (b.0 - a.0) * (p.1 - a.1) - (b.1 - a.1) * (p.0 - a.0);
         let b = [e(v[1], v[2]), e(v[2], v[0]), e(v[0], v[1])];
         let mut w = [0.0; 3];
         for k in 0..3 {
@@ -166,15 +180,12 @@ impl TriSetup {
         }
         let sum = w[0] + w[1] + w[2];
         let w = if sum > 0.0 {
-            w.map(|x| x / sum)
+            let inv = 1.0 / sum;
+            [w[0] * inv, w[1] * inv, w[2] * inv]
         } else {
             [1.0 / 3.0; 3]
         };
-        if self.swapped {
-            [w[0], w[2], w[1]]
-        } else {
-            w
-        }
+        if self.swapped { [w[0], w[2], w[1]] } else { w }
     }
 }
 

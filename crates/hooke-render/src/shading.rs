@@ -35,7 +35,12 @@ impl Shading {
 
     /// The colour of a surface of base `color` with (not necessarily unit) normal `n`.
     pub fn shade(&self, n: Vector3<f64>, color: Rgb) -> Rgb {
-        let n = n.try_normalize(1e-12).unwrap_or(-self.forward);
+        let len = n.norm();
+        let n = if len > 1e-12 {
+            n * (1.0 / len)
+        } else {
+            -self.forward
+        };
         let n = if n.dot(&self.forward) > 0.0 { -n } else { n };
         let diffuse = n.dot(&self.light).max(0.0);
         // x^32 by five squarings: the highlight's shape without a general power.

@@ -16,7 +16,7 @@ pub(crate) const LINE_DEPTH_BIAS: f64 = 2e-4;
 /// The samples of one tile: `area` in the sample buffer's coordinates.
 pub(crate) struct Samples {
     pub area: Rect,
-    stride: usize,
+    pub stride: usize,
     pub depth: Vec<f32>,
     pub id: Vec<u32>,
 }

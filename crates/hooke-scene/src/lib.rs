@@ -20,6 +20,7 @@ mod build;
 pub mod builtin;
 pub mod generators;
 pub mod spec;
+pub mod workload;
 pub mod world;
 
 pub use build::{

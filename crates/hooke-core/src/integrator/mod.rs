@@ -10,8 +10,8 @@ mod rk4;
 mod symplectic;
 
 use crate::assembly::{Assembly, BLOCK};
-use crate::parallel;
 use crate::model::Model;
+use crate::parallel;
 use crate::particles::{Particles, Vec3};
 use std::fmt;
 use std::str::FromStr;

@@ -20,7 +20,14 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
             &mut ws.vt,
         );
         ws.kx[stage].copy_from_slice(&ws.vt);
-        accelerations(model, &mut ws.assembly, p, &ws.xt, &ws.vt, &mut ws.kv[stage]);
+        accelerations(
+            model,
+            &mut ws.assembly,
+            p,
+            &ws.xt,
+            &ws.vt,
+            &mut ws.kv[stage],
+        );
     }
     let sixth = dt / 6.0;
     let [k1x, k2x, k3x, k4x] = &ws.kx;

@@ -1,0 +1,280 @@
+//! `hooke bench`: the cloth-N solver workload and the rasterizer benchmark.
+//!
+//! Figures are wall-clock times of release builds on whatever machine runs them; nothing
+//! here is asserted. `--json` prints one object per measurement for scripts.
+
+use crate::draw::{Style, draw, frame_camera};
+use crate::source;
+use anyhow::{Context, Result, bail};
+use hooke_core::Integrator;
+use hooke_render::{RenderOptions, Renderer};
+use hooke_scene::workload;
+use hooke_scene::{Overrides, Scene};
+use image::{ImageFormat, RgbaImage};
+use serde::Serialize;
+use std::io::Cursor;
+use std::path::Path;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// What `hooke bench` measures.
+#[derive(clap::Subcommand)]
+pub enum Bench {
+    /// The cloth-N workload (shared/bench/cloth-workload.md): steps/s and spring updates/s.
+    Cloth {
+        /// Particles along each side.
+        #[arg(long, default_value_t = 256)]
+        n: usize,
+        /// Measured steps (the centre particle's y is reported after them).
+        #[arg(long, default_value_t = workload::WORKLOAD_STEPS)]
+        steps: u64,
+        /// Worker threads (default: one per core).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Integrator.
+        #[arg(long, default_value_t = Integrator::Symplectic)]
+        integrator: Integrator,
+        /// Print one JSON object instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Rasterizer: render and PNG-encode times of stills.
+    Render {
+        /// What to draw: `cloth-N` is the workload grid of N×N particles (two triangles per
+        /// square) as built; anything else is a scene (built-in, .toml or .w) run to its end.
+        #[arg(default_values_t = ["cloth-256".to_string(), "cloth-1024".to_string(), "cloth-table".to_string()])]
+        targets: Vec<String>,
+        /// Also write each image as TARGET.png into this folder, to look at.
+        #[arg(long, value_name = "DIR")]
+        save: Option<std::path::PathBuf>,
+        /// Image size.
+        #[arg(long, default_value = "1024x1024", value_parser = crate::image_out::parse_size)]
+        size: (u32, u32),
+        /// Samples per pixel along each axis (2 = 4× anti-aliasing).
+        #[arg(long, default_value_t = 2)]
+        supersample: u32,
+        /// Timed repetitions; the median is reported.
+        #[arg(long, default_value_t = 5)]
+        repeat: usize,
+        /// Worker threads (default: one per core).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Print JSON objects instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(Serialize)]
+struct ClothFigures {
+    n: usize,
+    steps: u64,
+    threads: usize,
+    integrator: String,
+    springs: usize,
+    seconds: f64,
+    steps_per_s: f64,
+    spring_updates_per_s: f64,
+    center_y: f64,
+}
+
+#[derive(Serialize)]
+struct RenderFigures {
+    scene: String,
+    triangles: usize,
+    width: u32,
+    height: u32,
+    samples_per_pixel: u32,
+    threads: usize,
+    render_ms: f64,
+    png_encode_ms: f64,
+}
+
+fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = threads {
+        if t == 0 {
+            bail!("--threads: expected at least 1");
+        }
+        builder = builder.num_threads(t);
+    }
+    builder.build().context("cannot start the worker threads")
+}
+
+fn workload(n: usize, steps: u64, integrator: Integrator) -> Result<Scene> {
+    if !(3..=4096).contains(&n) {
+        bail!("--n: expected a cloth size from 3 to 4096, found {n}");
+    }
+    if steps == 0 {
+        bail!("--steps: expected at least 1");
+    }
+    let mut spec = workload::cloth(n);
+    Overrides {
+        integrator: Some(integrator),
+        steps: Some(steps),
+        ..Overrides::default()
+    }
+    .apply(&mut spec)?;
+    Ok(spec.build(Path::new("."))?)
+}
+
+pub fn run(bench: &Bench) -> Result<ExitCode> {
+    match bench {
+        Bench::Cloth {
+            n,
+            steps,
+            threads,
+            integrator,
+            json,
+        } => pool(*threads)?.install(|| cloth(*n, *steps, *integrator, *json)),
+        Bench::Render {
+            targets,
+            save,
+            size,
+            supersample,
+            repeat,
+            threads,
+            json,
+        } => pool(*threads)?.install(|| {
+            renders(
+                targets,
+                save.as_deref(),
+                *size,
+                *supersample,
+                (*repeat).max(1),
+                *json,
+            )
+        }),
+    }
+}
+
+fn cloth(n: usize, steps: u64, integrator: Integrator, json: bool) -> Result<ExitCode> {
+    // Warm-up on a separate copy: page in the buffers and start the workers, so the measured
+    // run starts from the workload's initial state.
+    let mut warm = workload(n, steps, integrator)?;
+    warm.simulation.advance(steps.min(20))?;
+    let mut scene = workload(n, steps, integrator)?;
+    let started = Instant::now();
+    scene.simulation.advance(steps)?;
+    let seconds = started.elapsed().as_secs_f64();
+    let springs = scene.simulation.model().springs.len();
+    let figures = ClothFigures {
+        n,
+        steps,
+        threads: rayon::current_num_threads(),
+        integrator: integrator.to_string(),
+        springs,
+        seconds,
+        steps_per_s: steps as f64 / seconds,
+        spring_updates_per_s: (springs as u64 * steps) as f64 / seconds,
+        center_y: scene.simulation.particles().x[workload::centre(n)].y,
+    };
+    if json {
+        println!("{}", serde_json::to_string(&figures)?);
+    } else {
+        println!(
+            "cloth N={n}: {springs} springs, {steps} {integrator} steps on {} threads in {:.3} s: \
+             {:.1} steps/s, {:.1} M spring updates/s; centre y = {:.12}",
+            figures.threads,
+            seconds,
+            figures.steps_per_s,
+            figures.spring_updates_per_s / 1e6,
+            figures.center_y
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn renders(
+    targets: &[String],
+    save: Option<&Path>,
+    (width, height): (u32, u32),
+    supersample: u32,
+    repeat: usize,
+    json: bool,
+) -> Result<ExitCode> {
+    let options = RenderOptions {
+        width,
+        height,
+        supersample: supersample.clamp(1, 4),
+        ..RenderOptions::default()
+    };
+    let mut scenes: Vec<(String, Scene)> = Vec::new();
+    for target in targets {
+        let grid = target
+            .strip_prefix("cloth-")
+            .and_then(|n| n.parse::<usize>().ok());
+        let scene = match grid {
+            Some(n) => workload(n, 1, Integrator::Symplectic)?,
+            None => {
+                let mut scene = source::build(target, &Overrides::default())?;
+                let steps = scene.steps;
+                scene.simulation.advance(steps)?;
+                scene
+            }
+        };
+        scenes.push((target.clone(), scene));
+    }
+    if let Some(dir) = save {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create output folder {}", dir.display()))?;
+    }
+
+    for (name, scene) in &scenes {
+        let list = draw(scene, Style::Solid);
+        let camera = frame_camera(scene, 30.0, 22.0);
+        // As an animation renders: one renderer, its buffers reused from frame to frame.
+        let mut renderer = Renderer::default();
+        let mut times = Vec::new();
+        let mut pixels = Vec::new();
+        for _ in 0..repeat {
+            let started = Instant::now();
+            pixels = renderer.render(&list, &camera, &options);
+            times.push(started.elapsed().as_secs_f64() * 1e3);
+        }
+        let image = RgbaImage::from_raw(width, height, pixels).context("image size")?;
+        if let Some(dir) = save {
+            let name = Path::new(name.as_str())
+                .file_stem()
+                .map_or_else(|| name.clone(), |s| s.to_string_lossy().into_owned());
+            crate::image_out::write_png(&dir.join(format!("{name}.png")), &image)?;
+        }
+        let mut encode = Vec::new();
+        for _ in 0..repeat {
+            let started = Instant::now();
+            let mut bytes = Vec::new();
+            image.write_to(&mut Cursor::new(&mut bytes), ImageFormat::Png)?;
+            encode.push(started.elapsed().as_secs_f64() * 1e3);
+        }
+        let figures = RenderFigures {
+            scene: name.clone(),
+            triangles: list.triangles.len(),
+            width,
+            height,
+            samples_per_pixel: options.supersample * options.supersample,
+            threads: rayon::current_num_threads(),
+            render_ms: median(times),
+            png_encode_ms: median(encode),
+        };
+        if json {
+            println!("{}", serde_json::to_string(&figures)?);
+        } else {
+            println!(
+                "{:<12} {:>8} triangles at {width}x{height}, {}x AA, {} threads: render {:.1} ms, \
+                 PNG encode {:.1} ms (median of {repeat})",
+                figures.scene,
+                figures.triangles,
+                figures.samples_per_pixel,
+                figures.threads,
+                figures.render_ms,
+                figures.png_encode_ms
+            );
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
