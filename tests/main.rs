@@ -6,6 +6,7 @@
 mod collisions;
 mod common;
 mod conservation;
+mod determinism;
 mod oscillator;
 mod scenes;
 mod worlds;

@@ -38,6 +38,20 @@ pub enum Bench {
         #[arg(long)]
         json: bool,
     },
+    /// Any scene (built-in, .toml or .w world): steps per second with its own integrator.
+    Scene {
+        /// Built-in name, .toml scene or .w world.
+        scene: String,
+        /// Measured steps.
+        #[arg(long, default_value_t = 20_000)]
+        steps: u64,
+        /// Worker threads (default: one per core).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Print one JSON object instead of text.
+        #[arg(long)]
+        json: bool,
+    },
     /// Rasterizer: render and PNG-encode times of stills.
     Render {
         /// What to draw: `cloth-N` is the workload grid of N×N particles (two triangles per
@@ -76,6 +90,18 @@ struct ClothFigures {
     steps_per_s: f64,
     spring_updates_per_s: f64,
     center_y: f64,
+}
+
+#[derive(Serialize)]
+struct SceneFigures {
+    scene: String,
+    integrator: String,
+    particles: usize,
+    springs: usize,
+    steps: u64,
+    threads: usize,
+    seconds: f64,
+    steps_per_s: f64,
 }
 
 #[derive(Serialize)]
@@ -127,6 +153,12 @@ pub fn run(bench: &Bench) -> Result<ExitCode> {
             integrator,
             json,
         } => pool(*threads)?.install(|| cloth(*n, *steps, *integrator, *json)),
+        Bench::Scene {
+            scene,
+            steps,
+            threads,
+            json,
+        } => pool(*threads)?.install(|| scene_steps(scene, *steps, *json)),
         Bench::Render {
             targets,
             save,
@@ -180,6 +212,43 @@ fn cloth(n: usize, steps: u64, integrator: Integrator, json: bool) -> Result<Exi
             figures.steps_per_s,
             figures.spring_updates_per_s / 1e6,
             figures.center_y
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn scene_steps(name: &str, steps: u64, json: bool) -> Result<ExitCode> {
+    if steps == 0 {
+        bail!("--steps: expected at least 1");
+    }
+    let mut scene = source::build(name, &Overrides::default())?;
+    let sim = &mut scene.simulation;
+    sim.advance(steps.min(100))?;
+    let started = Instant::now();
+    sim.advance(steps)?;
+    let seconds = started.elapsed().as_secs_f64();
+    let figures = SceneFigures {
+        scene: scene.spec.name.clone(),
+        integrator: sim.integrator().to_string(),
+        particles: sim.particles().len(),
+        springs: sim.model().springs.len(),
+        steps,
+        threads: rayon::current_num_threads(),
+        seconds,
+        steps_per_s: steps as f64 / seconds,
+    };
+    if json {
+        println!("{}", serde_json::to_string(&figures)?);
+    } else {
+        println!(
+            "{}: {} particles, {} springs, {steps} {} steps on {} threads in {:.3} s: {:.0} steps/s",
+            figures.scene,
+            figures.particles,
+            figures.springs,
+            figures.integrator,
+            figures.threads,
+            seconds,
+            figures.steps_per_s
         );
     }
     Ok(ExitCode::SUCCESS)

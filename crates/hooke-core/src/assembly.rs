@@ -2,7 +2,7 @@
 //! in a fixed order.
 //!
 //! Springs are sorted by their lower particle index (ties keep the model's order) and cut
-//! into partitions of [`PARTITION`] consecutive springs. Each partition
+//! into partitions of consecutive springs (their size set by the spring count alone). Each partition
 //! scatters its forces into a private buffer covering only the particles it touches (its
 //! *window*); a second pass gives each particle the sum of its external force and of every
 //! window holding it, in partition order. Partitions and reduction blocks are fixed by the
@@ -18,11 +18,22 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::ops::Range;
 
-/// Springs per partition: enough work to be worth a task, small enough for two cores to
-/// share the cloth-256 workload (392k springs, 24 partitions) evenly.
-pub const PARTITION: usize = 1 << 14;
+/// Springs per partition: a sixteenth of the springs, within these bounds. Large systems
+/// get partitions big enough that windows overlap little (the cloth-256 workload: 24 of
+/// 16k springs); a 6k-spring jelly still gets seven to share between cores. A function of
+/// the spring count alone, so the summation order never depends on the thread count.
+const PARTITION: (usize, usize) = (1 << 10, 1 << 14);
 
-/// Particles per reduction block.
+fn partition_size(springs: usize) -> usize {
+    (springs / 16).clamp(PARTITION.0, PARTITION.1)
+}
+
+/// Particles per reduction block: the gather adds external forces (a force field sample,
+/// collider queries), costly enough to share a 512-particle jelly in two.
+const REDUCE_BLOCK: usize = 256;
+
+/// Particles per block of the integrators' cheap per-particle updates: below this a
+/// system is updated inline, as a rayon call would cost more than the work.
 pub const BLOCK: usize = 1 << 12;
 
 /// The springs of a model in the solver's layout: end pairs, rest lengths and an index into
@@ -137,9 +148,9 @@ impl Assembly {
             table.param = Vec::new();
         }
         let partitions: Vec<Partition> = (0..springs.len())
-            .step_by(PARTITION)
+            .step_by(partition_size(springs.len()))
             .map(|start| {
-                let range = start..(start + PARTITION).min(springs.len());
+                let range = start..(start + partition_size(springs.len())).min(springs.len());
                 let ends = table.ends[range.clone()].iter().flatten();
                 let lo = ends.clone().copied().min().unwrap_or(0) as usize;
                 let hi = ends.copied().max().unwrap_or(0) as usize;
@@ -150,11 +161,11 @@ impl Assembly {
                 }
             })
             .collect();
-        let blocks = particles.div_ceil(BLOCK);
+        let blocks = particles.div_ceil(REDUCE_BLOCK);
         let mut block_start = vec![0u32];
         let mut block_parts = Vec::new();
         for b in 0..blocks {
-            let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(particles));
+            let (lo, hi) = (b * REDUCE_BLOCK, ((b + 1) * REDUCE_BLOCK).min(particles));
             for (k, part) in partitions.iter().enumerate() {
                 if part.lo < hi && part.lo + part.force.len() > lo {
                     block_parts.push(k as u32);
@@ -223,7 +234,7 @@ impl Assembly {
     /// The total spring force on particle `p` from the last [`Assembly::scatter`].
     #[inline]
     pub fn spring_force(&self, p: usize) -> Vec3 {
-        let b = p / BLOCK;
+        let b = p / REDUCE_BLOCK;
         let parts =
             &self.block_parts[self.block_start[b] as usize..self.block_start[b + 1] as usize];
         let mut f = Vec3::zeros();
@@ -263,12 +274,12 @@ impl Assembly {
                 };
             }
         };
-        if a.len() <= BLOCK {
+        if a.len() <= REDUCE_BLOCK {
             gather(0, a);
         } else {
-            a.par_chunks_mut(BLOCK)
+            a.par_chunks_mut(REDUCE_BLOCK)
                 .enumerate()
-                .for_each(|(b, a)| gather(b * BLOCK, a));
+                .for_each(|(b, a)| gather(b * REDUCE_BLOCK, a));
         }
     }
 }

@@ -48,12 +48,13 @@ impl ForceField {
             return self.values[0];
         }
         let h = 2.0 * FIELD_HALF_EXTENT / (r - 1) as f64;
+        let inv_h = (r - 1) as f64 / (2.0 * FIELD_HALF_EXTENT);
         // Cell index and fraction along one axis, with the point clamped to the box and the
         // last node folded into the last cell so that `index + 1` stays on the grid.
         let axis = |x: f64| -> (usize, f64) {
             let x = x.clamp(-FIELD_HALF_EXTENT, FIELD_HALF_EXTENT);
-            let cell = (((x + FIELD_HALF_EXTENT) / h) as usize).min(r - 2);
-            let t = (x - (-FIELD_HALF_EXTENT + cell as f64 * h)) / h;
+            let cell = (((x + FIELD_HALF_EXTENT) * inv_h) as usize).min(r - 2);
+            let t = (x - (-FIELD_HALF_EXTENT + cell as f64 * h)) * inv_h;
             (cell, t)
         };
         let (a, tx) = axis(p.x);
