@@ -7,6 +7,7 @@ mod collisions;
 mod common;
 mod conservation;
 mod determinism;
+mod images;
 mod oscillator;
 mod scenes;
 mod worlds;

@@ -19,6 +19,8 @@ const CLOTH: Rgb = [0.22, 0.42, 0.78];
 const JELLY: Rgb = [0.36, 0.74, 0.30];
 const BEAD: Rgb = [0.80, 0.30, 0.20];
 const STRING: Rgb = [0.25, 0.25, 0.28];
+/// Pinned particles: dark, like the fixed hook they hang from.
+const PIN: Rgb = [0.30, 0.30, 0.34];
 const TABLE: Rgb = [0.58, 0.40, 0.24];
 const PLANE: Rgb = [0.85, 0.55, 0.65];
 const EDGE: Rgb = [0.25, 0.28, 0.35];
@@ -124,6 +126,46 @@ fn cylinder(list: &mut DrawList, c: &hooke_collide::Cylinder) {
     }
 }
 
+/// A helical spring from `a` to `b`: a fixed number of turns, so it visibly stretches.
+fn coil(list: &mut DrawList, a: Vec3, b: Vec3, rest: f64) {
+    const TURNS: usize = 14;
+    const SEGMENTS: usize = 12;
+    let axis = b - a;
+    let Some(dir) = axis.try_normalize(1e-12) else {
+        return;
+    };
+    let helper = if dir.x.abs() < 0.9 {
+        Vec3::x()
+    } else {
+        Vec3::y()
+    };
+    let (u, v) = (
+        dir.cross(&helper).normalize(),
+        dir.cross(&helper).normalize().cross(&dir),
+    );
+    let radius = 0.06 * rest.max(0.05);
+    // Straight leads at both ends, the helix between.
+    let lead = 0.08;
+    let point = |k: usize| {
+        let t = k as f64 / (TURNS * SEGMENTS) as f64;
+        let angle = std::f64::consts::TAU * TURNS as f64 * t;
+        a + axis * (lead + (1.0 - 2.0 * lead) * t) + (u * angle.cos() + v * angle.sin()) * radius
+    };
+    let mut line = |p: Vec3, q: Vec3| {
+        list.lines.push(Line {
+            a: p,
+            b: q,
+            color: STRING,
+            width: 2.0,
+        })
+    };
+    line(a, point(0));
+    for k in 0..TURNS * SEGMENTS {
+        line(point(k), point(k + 1));
+    }
+    line(point(TURNS * SEGMENTS), b);
+}
+
 /// Corner `k` of the box: x from bit 2, y from bit 1, z from bit 0.
 fn box_corner(min: Vec3, max: Vec3, k: usize) -> Vec3 {
     let pick = |bit: usize, lo: f64, hi: f64| if k & bit != 0 { hi } else { lo };
@@ -212,10 +254,11 @@ pub fn draw(scene: &Scene, style: Style) -> DrawList {
             }
             Topology::Chain | Topology::Points => {
                 for i in body.range.clone() {
+                    let pinned = sim.particles().is_pinned(i);
                     list.points.push(Point {
                         p: x[i],
-                        color: BEAD,
-                        radius: 6.0,
+                        color: if pinned { PIN } else { BEAD },
+                        radius: if pinned { 5.0 } else { 6.0 },
                     });
                 }
             }
@@ -229,9 +272,21 @@ pub fn draw(scene: &Scene, style: Style) -> DrawList {
         .filter(|b| matches!(b.topology, Topology::Chain | Topology::Points))
         .map(|b| b.range.clone())
         .collect::<Vec<_>>();
+    // A lone spring reads as a spring when drawn as a coil; in a chain of many, coils would
+    // crowd, and a string reads better.
+    let coils = scene
+        .bodies
+        .iter()
+        .filter(|b| matches!(b.topology, Topology::Chain | Topology::Points) && b.range.len() <= 3)
+        .map(|b| b.range.clone())
+        .collect::<Vec<_>>();
     for spring in &sim.model().springs {
         let (i, j) = (spring.i as usize, spring.j as usize);
         let on_string = strings.iter().any(|r| r.contains(&i));
+        if !lines_for_all && coils.iter().any(|r| r.contains(&i)) {
+            coil(&mut list, x[i], x[j], spring.rest);
+            continue;
+        }
         if lines_for_all || on_string {
             let color = if on_string && !lines_for_all {
                 STRING

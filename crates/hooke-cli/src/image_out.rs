@@ -33,6 +33,7 @@ pub struct View {
     pub supersample: u32,
 }
 
+/// Parses `WIDTHxHEIGHT`, each from 8 to 8192 pixels.
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once('x')

@@ -1,16 +1,13 @@
 //! `hooke`: run, render and inspect mass-spring scenes.
 
 mod bench;
-mod draw;
-mod image_out;
-mod output;
 mod picture;
 mod run;
-mod source;
 mod trajectory;
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
+use hooke_cli::{draw, image_out, output, source};
 use hooke_core::Integrator;
 use hooke_scene::Overrides;
 use std::path::PathBuf;

@@ -5,6 +5,7 @@ use crate::image_out::{View, write_gif, write_png};
 use crate::run::drive;
 use crate::source;
 use anyhow::{Context, Result};
+use hooke_cli::stills::{still_scene, still_view};
 use hooke_scene::builtin::BUILTINS;
 use hooke_scene::{Overrides, Scene};
 use std::path::{Path, PathBuf};
@@ -38,10 +39,6 @@ pub fn render(args: &RenderArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Scenes whose demo still is taken before the end of the run, and when (seconds): the jelly
-/// is most telling at impact, squashed against the ground.
-const STILL_AT: [(&str, f64); 1] = [("jello-cube", 0.45)];
-
 /// The scene animated in `demo`, and its frame interval in seconds.
 const ANIMATED: (&str, f64) = ("hanging-cloth", 0.1);
 
@@ -51,22 +48,9 @@ pub fn demo(out: &Path, view: &View) -> Result<ExitCode> {
     let mut written: Vec<PathBuf> = Vec::new();
     for (k, (name, _)) in BUILTINS.iter().enumerate() {
         let started = Instant::now();
-        let mut scene = source::build(name, &Overrides::default())?;
-        let steps = match STILL_AT.iter().find(|(n, _)| n == name) {
-            Some((_, t)) => (t / scene.simulation.dt()).round() as u64,
-            None => scene.steps,
-        };
-        advance(&mut scene, steps)?;
+        let scene = still_scene(name)?;
         let simulated = started.elapsed();
-        // The cloth hangs in the y-z plane from its pins: look at its face, not its edge.
-        let view = if *name == "hanging-cloth" {
-            View {
-                yaw: view.yaw + 35.0,
-                ..view.clone()
-            }
-        } else {
-            view.clone()
-        };
+        let view = still_view(name, view);
         let camera = view.camera(&scene);
         let path = out.join(format!("{}-{name}.png", k + 1));
         write_png(&path, &view.pixels(&scene, &camera))?;

@@ -1,0 +1,9 @@
+//! The library half of the `hooke` command: turning scenes into draw lists and images,
+//! reading SCENE arguments, atomic output files and the demo's stills. The binary's
+//! commands are built on it, and the validation suite renders its golden images with it.
+
+pub mod draw;
+pub mod image_out;
+pub mod output;
+pub mod source;
+pub mod stills;

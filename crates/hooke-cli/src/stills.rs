@@ -1,0 +1,50 @@
+//! The demo's still of each built-in scene: when it is taken and from where. `hooke demo`
+//! writes them; the validation suite compares them with the golden images.
+
+use crate::image_out::View;
+use crate::source;
+use anyhow::Result;
+use hooke_scene::{Overrides, Scene};
+
+/// Scenes whose still is taken before the end of the run, and when (seconds): the jelly is
+/// most telling at impact, squashed against the ground.
+const STILL_AT: [(&str, f64); 1] = [("jello-cube", 0.45)];
+
+/// Builds built-in scene `name` and runs it to the moment of its still.
+pub fn still_scene(name: &str) -> Result<Scene> {
+    let mut scene = source::build(name, &Overrides::default())?;
+    let steps = match STILL_AT.iter().find(|(n, _)| *n == name) {
+        Some((_, t)) => (t / scene.simulation.dt()).round() as u64,
+        None => scene.steps,
+    };
+    scene.steps = steps;
+    scene.simulation.advance(steps)?;
+    Ok(scene)
+}
+
+/// The view of built-in scene `name`'s still, from the user's `view`.
+pub fn still_view(name: &str, view: &View) -> View {
+    // The cloth hangs in the y-z plane from its pins: look at its face, not its edge.
+    if name == "hanging-cloth" {
+        View {
+            yaw: view.yaw + 35.0,
+            ..view.clone()
+        }
+    } else {
+        view.clone()
+    }
+}
+
+impl Default for View {
+    /// The command line's defaults: 800×600, solid, yaw 30°, pitch 22°, 4× anti-aliasing.
+    fn default() -> Self {
+        Self {
+            size: (800, 600),
+            style: crate::draw::Style::Solid,
+            yaw: 30.0,
+            pitch: 22.0,
+            zoom: 1.0,
+            supersample: 2,
+        }
+    }
+}
