@@ -75,6 +75,7 @@ fn each_integrator_converges_at_its_order() {
         (Integrator::Symplectic, 2e-3),
         (Integrator::Midpoint, 4e-3),
         (Integrator::Rk4, 2e-2),
+        (Integrator::Implicit, 2e-3),
     ] {
         let errors: Vec<f64> = [1.0, 0.5, 0.25]
             .iter()

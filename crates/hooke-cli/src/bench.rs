@@ -45,6 +45,12 @@ pub enum Bench {
         /// Measured steps.
         #[arg(long, default_value_t = 20_000)]
         steps: u64,
+        /// Integrator (default: the scene's).
+        #[arg(long)]
+        integrator: Option<Integrator>,
+        /// Step size in seconds (default: the scene's).
+        #[arg(long)]
+        dt: Option<f64>,
         /// Worker threads (default: one per core).
         #[arg(long)]
         threads: Option<usize>,
@@ -95,6 +101,9 @@ struct ClothFigures {
 #[derive(Serialize)]
 struct SceneFigures {
     scene: String,
+    dt: f64,
+    /// Average conjugate-gradient iterations per step (implicit only).
+    cg_iterations_per_step: f64,
     integrator: String,
     particles: usize,
     springs: usize,
@@ -156,9 +165,18 @@ pub fn run(bench: &Bench) -> Result<ExitCode> {
         Bench::Scene {
             scene,
             steps,
+            integrator,
+            dt,
             threads,
             json,
-        } => pool(*threads)?.install(|| scene_steps(scene, *steps, *json)),
+        } => {
+            let overrides = Overrides {
+                integrator: *integrator,
+                dt: *dt,
+                ..Overrides::default()
+            };
+            pool(*threads)?.install(|| scene_steps(scene, &overrides, *steps, *json))
+        }
         Bench::Render {
             targets,
             save,
@@ -217,17 +235,23 @@ fn cloth(n: usize, steps: u64, integrator: Integrator, json: bool) -> Result<Exi
     Ok(ExitCode::SUCCESS)
 }
 
-fn scene_steps(name: &str, steps: u64, json: bool) -> Result<ExitCode> {
+fn scene_steps(name: &str, overrides: &Overrides, steps: u64, json: bool) -> Result<ExitCode> {
     if steps == 0 {
         bail!("--steps: expected at least 1");
     }
-    let mut scene = source::build(name, &Overrides::default())?;
+    let mut scene = source::build(name, overrides)?;
     let sim = &mut scene.simulation;
     sim.advance(steps.min(100))?;
     let started = Instant::now();
-    sim.advance(steps)?;
+    let mut cg_iterations = 0;
+    for _ in 0..steps {
+        sim.step()?;
+        cg_iterations += sim.workspace().cg_iterations();
+    }
     let seconds = started.elapsed().as_secs_f64();
     let figures = SceneFigures {
+        cg_iterations_per_step: cg_iterations as f64 / steps as f64,
+        dt: sim.dt(),
         scene: scene.spec.name.clone(),
         integrator: sim.integrator().to_string(),
         particles: sim.particles().len(),
@@ -241,14 +265,25 @@ fn scene_steps(name: &str, steps: u64, json: bool) -> Result<ExitCode> {
         println!("{}", serde_json::to_string(&figures)?);
     } else {
         println!(
-            "{}: {} particles, {} springs, {steps} {} steps on {} threads in {:.3} s: {:.0} steps/s",
+            "{}: {} particles, {} springs, {steps} {} steps of {} s on {} threads in {:.3} s: \
+             {:.0} steps/s, {:.3} s per simulated second{}",
             figures.scene,
             figures.particles,
             figures.springs,
             figures.integrator,
+            figures.dt,
             figures.threads,
             seconds,
-            figures.steps_per_s
+            figures.steps_per_s,
+            seconds / (steps as f64 * figures.dt),
+            if cg_iterations > 0 {
+                format!(
+                    ", {:.1} CG iterations per step",
+                    figures.cg_iterations_per_step
+                )
+            } else {
+                String::new()
+            }
         );
     }
     Ok(ExitCode::SUCCESS)

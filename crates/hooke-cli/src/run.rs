@@ -174,10 +174,17 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
             }
             _ => "",
         };
-        println!(
-            "  {:<11} stable for dt < {limit:.3e} s{note}{mark}",
-            integrator.name()
-        );
+        if limit.is_finite() {
+            println!(
+                "  {:<11} stable for dt < {limit:.3e} s{note}{mark}",
+                integrator.name()
+            );
+        } else {
+            println!(
+                "  {:<11} stable for any dt (accuracy still wants small steps){mark}",
+                integrator.name()
+            );
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -48,6 +48,73 @@ struct SpringTable {
     params: Vec<[f64; 2]>,
 }
 
+/// A symmetric 3×3 matrix: `[xx, yy, zz, xy, xz, yz]`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Sym3(pub [f64; 6]);
+
+impl Sym3 {
+    /// `u uᵀ`.
+    pub fn outer(u: &Vec3) -> Self {
+        Self([
+            u.x * u.x,
+            u.y * u.y,
+            u.z * u.z,
+            u.x * u.y,
+            u.x * u.z,
+            u.y * u.z,
+        ])
+    }
+
+    /// `s · self`.
+    pub fn scale(self, s: f64) -> Self {
+        Self(self.0.map(|v| v * s))
+    }
+
+    /// `self + s I`.
+    pub fn plus_identity(mut self, s: f64) -> Self {
+        for k in 0..3 {
+            self.0[k] += s;
+        }
+        self
+    }
+
+    /// `self + other`.
+    pub fn plus(self, other: &Sym3) -> Self {
+        Self(std::array::from_fn(|k| self.0[k] + other.0[k]))
+    }
+
+    /// `self · v`.
+    #[inline]
+    pub fn mul(&self, v: &Vec3) -> Vec3 {
+        let [xx, yy, zz, xy, xz, yz] = self.0;
+        Vec3::new(
+            xx * v.x + xy * v.y + xz * v.z,
+            xy * v.x + yy * v.y + yz * v.z,
+            xz * v.x + yz * v.y + zz * v.z,
+        )
+    }
+
+    /// The inverse, or `None` when the matrix is singular.
+    pub fn inverse(&self) -> Option<Self> {
+        let [a, d, f, b, c, e] = self.0;
+        // Cofactors of [[a b c] [b d e] [c e f]].
+        let (ca, cb, cc) = (d * f - e * e, c * e - b * f, b * e - c * d);
+        let det = a * ca + b * cb + c * cc;
+        if det.abs() <= f64::MIN_POSITIVE {
+            return None;
+        }
+        let inv = 1.0 / det;
+        Some(Self([
+            ca * inv,
+            (a * f - c * c) * inv,
+            (a * d - b * b) * inv,
+            cb * inv,
+            cc * inv,
+            (b * c - a * e) * inv,
+        ]))
+    }
+}
+
 /// Springs computed side by side in the force loop.
 const LANES: usize = 2;
 
@@ -228,6 +295,75 @@ impl Assembly {
             scatter(&mut self.partitions[0]);
         } else {
             self.partitions.par_iter_mut().for_each(scatter);
+        }
+    }
+
+    /// Scatters an antisymmetric per-spring quantity: `g(k, i, j)` is added at the spring's
+    /// lower end `i` and subtracted at `j`; [`Assembly::spring_force`] then reads the sums.
+    /// `k` indexes the assembly's own (sorted) spring order, as [`Assembly::spring_blocks`]
+    /// does. This is how the implicit integrator multiplies by its system matrix.
+    pub fn scatter_pairs(&mut self, g: impl Fn(usize, usize, usize) -> Vec3 + Sync) {
+        let table = &self.table;
+        let scatter = |part: &mut Partition| {
+            part.force.fill(Vec3::zeros());
+            let lo = part.lo;
+            for k in part.springs.clone() {
+                let [i, j] = table.ends[k];
+                let (i, j) = (i as usize, j as usize);
+                let f = g(k, i, j);
+                part.force[i - lo] += f;
+                part.force[j - lo] -= f;
+            }
+        };
+        if self.partitions.len() == 1 {
+            scatter(&mut self.partitions[0]);
+        } else {
+            self.partitions.par_iter_mut().for_each(scatter);
+        }
+    }
+
+    /// Number of springs, in the assembly's order.
+    pub fn springs(&self) -> usize {
+        self.table.ends.len()
+    }
+
+    /// The end particles `[i, j]` (lower first) of the assembly's spring `k`.
+    pub fn ends(&self, k: usize) -> [usize; 2] {
+        let [i, j] = self.table.ends[k];
+        [i as usize, j as usize]
+    }
+
+    /// Each spring's force derivatives at `x`, as positive semi-definite blocks (with
+    /// `u = (x_i - x_j)/l`): the elastic `Kₛ = ks (u uᵀ + max(0, 1 - L/l)(I - u uᵀ))`, so that
+    /// `∂f_i/∂x_i = -Kₛ`, and the damping `Dₛ = kd u uᵀ`, `∂f_i/∂v_i = -Dₛ`. The transverse
+    /// term is clamped at zero for compressed springs (Choi & Ko 2002), which keeps the
+    /// implicit system positive definite.
+    pub fn spring_blocks(&self, x: &[Vec3], out: &mut Vec<[Sym3; 2]>) {
+        let table = &self.table;
+        out.resize(table.ends.len(), [Sym3::default(); 2]);
+        let block = |k: usize| {
+            let [i, j] = table.ends[k];
+            let d = x[i as usize] - x[j as usize];
+            let len = d.norm();
+            if len < crate::spring::DEGENERATE_LENGTH {
+                return [Sym3::default(); 2];
+            }
+            let u = d * (1.0 / len);
+            let [ks, kd] = table.params(k);
+            let uu = Sym3::outer(&u);
+            let transverse = (1.0 - table.rest[k] / len).max(0.0);
+            let elastic = uu
+                .scale(ks * (1.0 - transverse))
+                .plus_identity(ks * transverse);
+            [elastic, uu.scale(kd)]
+        };
+        if out.len() <= PARTITION.0 {
+            out.iter_mut().enumerate().for_each(|(k, o)| *o = block(k));
+        } else {
+            out.par_iter_mut()
+                .with_min_len(PARTITION.0)
+                .enumerate()
+                .for_each(|(k, o)| *o = block(k));
         }
     }
 

@@ -43,7 +43,7 @@ mod spring;
 mod stability;
 mod summary;
 
-pub use assembly::Assembly;
+pub use assembly::{Assembly, Sym3};
 pub use collider::{Collider, Contact};
 pub use force_field::{FIELD_HALF_EXTENT, ForceField};
 pub use integrator::{Integrator, UnknownIntegrator, Workspace};

@@ -68,3 +68,42 @@ pub(crate) fn all_sane(x: &[Vec3], v: &[Vec3], bound: f64) -> bool {
             .all(|(x, v)| block(x, v))
     }
 }
+
+/// Elements per block of the vector helpers below.
+const VECTOR_BLOCK: usize = 1 << 12;
+
+/// `out[i] = f(i, &mut out[i])` for every particle, in parallel blocks for large systems.
+pub(crate) fn for_each(out: &mut [Vec3], f: impl Fn(usize, &mut Vec3) + Sync + Send) {
+    if out.len() <= VECTOR_BLOCK {
+        out.iter_mut().enumerate().for_each(|(i, o)| f(i, o));
+    } else {
+        out.par_chunks_mut(VECTOR_BLOCK)
+            .enumerate()
+            .for_each(|(b, chunk)| {
+                for (k, o) in chunk.iter_mut().enumerate() {
+                    f(b * VECTOR_BLOCK + k, o);
+                }
+            });
+    }
+}
+
+/// `y += a x`.
+pub(crate) fn axpy(y: &mut [Vec3], a: f64, x: &[Vec3]) {
+    for_each(y, |i, y| *y += x[i] * a);
+}
+
+/// `Σ a_i · b_i`, summed in fixed blocks whose partial sums are added in order: the same
+/// bits on any number of threads.
+pub(crate) fn dot(a: &[Vec3], b: &[Vec3]) -> f64 {
+    let block = |(a, b): (&[Vec3], &[Vec3])| a.iter().zip(b).map(|(a, b)| a.dot(b)).sum::<f64>();
+    if a.len() <= VECTOR_BLOCK {
+        block((a, b))
+    } else {
+        let partial: Vec<f64> = a
+            .par_chunks(VECTOR_BLOCK)
+            .zip(b.par_chunks(VECTOR_BLOCK))
+            .map(block)
+            .collect();
+        partial.iter().sum()
+    }
+}

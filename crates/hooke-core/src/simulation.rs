@@ -83,6 +83,11 @@ impl Simulation {
         &self.model
     }
 
+    /// The integrators' buffers (for figures such as [`Workspace::cg_iterations`]).
+    pub fn workspace(&self) -> &Workspace {
+        &self.workspace
+    }
+
     /// The integrator in use.
     pub fn integrator(&self) -> Integrator {
         self.integrator

@@ -75,6 +75,8 @@ impl StabilityEstimate {
             // |1 + z + z²/2 + z³/6 + z⁴/24| ≤ 1 on the imaginary axis up to |z| = 2√2.
             Integrator::Rk4 => 2.0 * std::f64::consts::SQRT_2,
             Integrator::Euler | Integrator::Symplectic | Integrator::Midpoint => 2.0,
+            // Backward Euler is stable for every step.
+            Integrator::Implicit => return f64::INFINITY,
         };
         bound / self.omega_max
     }

@@ -5,6 +5,7 @@
 //! once after the full step.
 
 mod euler;
+mod implicit;
 mod midpoint;
 mod rk4;
 mod symplectic;
@@ -29,11 +30,20 @@ pub enum Integrator {
     Midpoint,
     /// Classic fourth-order Runge–Kutta. Order 4; stable for `dt < 2.8 / ω_max`.
     Rk4,
+    /// Implicit (backward) Euler linearised at the current state and solved with
+    /// conjugate gradients (Baraff & Witkin 1998). Order 1; stable for any `dt`, damps.
+    Implicit,
 }
 
 impl Integrator {
     /// All integrators, in the order of SPEC §4.
-    pub const ALL: [Integrator; 4] = [Self::Euler, Self::Symplectic, Self::Midpoint, Self::Rk4];
+    pub const ALL: [Integrator; 5] = [
+        Self::Euler,
+        Self::Symplectic,
+        Self::Midpoint,
+        Self::Rk4,
+        Self::Implicit,
+    ];
 
     /// The name used on the command line and in scene files.
     pub fn name(self) -> &'static str {
@@ -42,6 +52,7 @@ impl Integrator {
             Self::Symplectic => "symplectic",
             Self::Midpoint => "midpoint",
             Self::Rk4 => "rk4",
+            Self::Implicit => "implicit",
         }
     }
 
@@ -51,6 +62,7 @@ impl Integrator {
             Self::Euler | Self::Symplectic => 1,
             Self::Midpoint => 2,
             Self::Rk4 => 4,
+            Self::Implicit => 1,
         }
     }
 
@@ -60,6 +72,8 @@ impl Integrator {
             Self::Euler | Self::Symplectic => 1,
             Self::Midpoint => 2,
             Self::Rk4 => 4,
+            // One evaluation, then a linear solve of a few to a few hundred iterations.
+            Self::Implicit => 1,
         }
     }
 
@@ -71,6 +85,7 @@ impl Integrator {
             Self::Symplectic => symplectic::step(model, particles, dt, ws),
             Self::Midpoint => midpoint::step(model, particles, dt, ws),
             Self::Rk4 => rk4::step(model, particles, dt, ws),
+            Self::Implicit => implicit::step(model, particles, dt, ws),
         }
     }
 }
@@ -83,7 +98,7 @@ impl fmt::Display for Integrator {
 
 /// The error for an integrator name that is not one of [`Integrator::ALL`].
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("unknown integrator '{0}': expected one of euler, symplectic, midpoint, rk4")]
+#[error("unknown integrator '{0}': expected one of euler, symplectic, midpoint, rk4, implicit")]
 pub struct UnknownIntegrator(pub String);
 
 impl FromStr for Integrator {
@@ -111,9 +126,16 @@ pub struct Workspace {
     /// A trial state for evaluating stages.
     pub(crate) xt: Vec<Vec3>,
     pub(crate) vt: Vec<Vec3>,
+    /// The implicit integrator's blocks and preconditioner.
+    pub(crate) implicit: implicit::ImplicitBuffers,
 }
 
 impl Workspace {
+    /// Conjugate-gradient iterations of the last implicit step (0 for other integrators).
+    pub fn cg_iterations(&self) -> usize {
+        self.implicit.iterations
+    }
+
     fn ensure(&mut self, model: &Model, particles: usize) {
         let springs = model.springs.len();
         if !self.assembly.fits(particles, springs) {
