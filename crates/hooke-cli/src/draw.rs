@@ -233,6 +233,12 @@ fn plane_in_box(list: &mut DrawList, coefficients: [f64; 4], min: Vec3, max: Vec
 
 /// The draw list of a scene's current state.
 pub fn draw(scene: &Scene, style: Style) -> DrawList {
+    draw_with(scene, style, |_| true)
+}
+
+/// [`draw`], showing only the springs of the kinds `show` accepts (the viewer's s / h / b
+/// toggles); chains' strings and lone coils are always drawn.
+pub fn draw_with(scene: &Scene, style: Style, show: impl Fn(SpringKind) -> bool) -> DrawList {
     let mut list = DrawList::default();
     let sim = &scene.simulation;
     let x = &sim.particles().x;
@@ -287,7 +293,7 @@ pub fn draw(scene: &Scene, style: Style) -> DrawList {
             coil(&mut list, x[i], x[j], spring.rest);
             continue;
         }
-        if lines_for_all || on_string {
+        if (lines_for_all && show(spring.kind)) || on_string {
             let color = if on_string && !lines_for_all {
                 STRING
             } else {

@@ -4,6 +4,7 @@ mod bench;
 mod picture;
 mod run;
 mod trajectory;
+mod view;
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
@@ -50,6 +51,8 @@ enum Command {
         #[command(flatten)]
         setup: SetupArgs,
     },
+    /// Show scenes live in a window (TAB cycles, R replays, drag rotates, SHIFT+drag zooms).
+    View(view::ViewArgs),
     /// Benchmarks: the cloth-N solver workload and the rasterizer.
     #[command(subcommand)]
     Bench(bench::Bench),
@@ -166,5 +169,6 @@ fn dispatch(command: Command) -> Result<ExitCode> {
         Command::Check { scene, setup } => run::check(&scene, &setup),
         Command::Convert { input, output } => run::convert(&input, &output),
         Command::Bench(bench) => bench::run(&bench),
+        Command::View(args) => view::run(&args),
     }
 }

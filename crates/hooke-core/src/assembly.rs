@@ -383,11 +383,16 @@ impl Assembly {
         f
     }
 
-    /// The total force on particle `p`: external forces plus springs (after a scatter at the
-    /// same `(x, v)`).
+    /// The total force on particle `p`: external forces, attachments and springs (after a
+    /// scatter at the same `(x, v)`).
     #[inline]
     pub fn force(&self, model: &Model, mass: f64, x: &Vec3, v: &Vec3, p: usize) -> Vec3 {
-        model.external_force(mass, x, v) + self.spring_force(p)
+        let f = model.external_force(mass, x, v) + self.spring_force(p);
+        if model.attachments.is_empty() {
+            f
+        } else {
+            f + model.attachment_force(p, x, v)
+        }
     }
 
     /// `a = F(x, v) / m` for every particle; pinned particles get zero.

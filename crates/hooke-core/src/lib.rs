@@ -47,7 +47,7 @@ pub use assembly::{Assembly, Sym3};
 pub use collider::{Collider, Contact};
 pub use force_field::{FIELD_HALF_EXTENT, ForceField};
 pub use integrator::{Integrator, UnknownIntegrator, Workspace};
-pub use model::{ColliderSlot, Model};
+pub use model::{Attachment, ColliderSlot, Model};
 pub use particles::{Particles, Vec3};
 pub use response::Response;
 pub use simulation::{Divergence, SANE_BOUND, Simulation};

@@ -32,6 +32,22 @@ pub struct Model {
     pub field: Option<ForceField>,
     /// Colliders, each with its response.
     pub colliders: Vec<ColliderSlot>,
+    /// Particles tied to points in space, such as a particle grabbed with the mouse.
+    pub attachments: Vec<Attachment>,
+}
+
+/// A zero-length damped spring from a particle to a point in space: the force
+/// `-ks (x - target) - kd v`. The viewer's grab is one; the target may move between steps.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Attachment {
+    /// The particle held.
+    pub particle: usize,
+    /// Where it is pulled, metres.
+    pub target: Vec3,
+    /// Stiffness, N/m.
+    pub ks: f64,
+    /// Damping, N·s/m.
+    pub kd: f64,
 }
 
 /// Particles per parallel block of collision responses.
@@ -53,6 +69,16 @@ impl Model {
                 slot.shape
                     .contacts(x, &mut |c: Contact| f += slot.response.penalty_force(&c, v));
             }
+        }
+        f
+    }
+
+    /// The force of the attachments holding particle `p`.
+    #[inline]
+    pub fn attachment_force(&self, p: usize, x: &Vec3, v: &Vec3) -> Vec3 {
+        let mut f = Vec3::zeros();
+        for a in self.attachments.iter().filter(|a| a.particle == p) {
+            f -= (x - a.target) * a.ks + v * a.kd;
         }
         f
     }

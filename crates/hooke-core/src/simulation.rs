@@ -1,7 +1,7 @@
 //! A running system: particles, model, integrator and step size, stepped with divergence checks.
 
 use crate::integrator::{Integrator, Workspace};
-use crate::model::Model;
+use crate::model::{Attachment, Model};
 use crate::parallel;
 use crate::particles::{Particles, Vec3};
 use crate::stability::StabilityEstimate;
@@ -81,6 +81,12 @@ impl Simulation {
     /// The force model.
     pub fn model(&self) -> &Model {
         &self.model
+    }
+
+    /// Replaces the model's attachments (particles tied to points in space), e.g. to follow
+    /// a mouse grab; takes effect from the next step.
+    pub fn set_attachments(&mut self, attachments: Vec<Attachment>) {
+        self.model.attachments = attachments;
     }
 
     /// The integrators' buffers (for figures such as [`Workspace::cg_iterations`]).

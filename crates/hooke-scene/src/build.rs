@@ -357,6 +357,7 @@ impl SceneSpec {
             drag: self.simulation.drag.0,
             field,
             colliders: slots,
+            attachments: Vec::new(),
         };
         let simulation = Simulation::new(
             particles,
