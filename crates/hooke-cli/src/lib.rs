@@ -4,6 +4,7 @@
 
 pub mod draw;
 pub mod image_out;
+pub mod interrupt;
 pub mod output;
 pub mod source;
 pub mod stills;

@@ -141,6 +141,7 @@ struct RenderArgs {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    hooke_cli::interrupt::install();
     match dispatch(cli.command) {
         Ok(code) => code,
         Err(e) => {

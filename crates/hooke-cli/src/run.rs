@@ -4,6 +4,7 @@ use crate::source;
 use crate::trajectory::TrajectoryWriter;
 use crate::{RunArgs, SetupArgs};
 use anyhow::{Context, Result, bail};
+use hooke_cli::interrupt::{self, Interrupted};
 use hooke_core::{Divergence, Integrator, StabilityEstimate, Summary};
 use hooke_scene::Scene;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -29,20 +30,39 @@ pub fn drive(scene: &mut Scene, mut on_frame: impl FnMut(u64, &Scene) -> Result<
     } else {
         ProgressBar::hidden()
     };
+    // Steps one at a time so that Ctrl-C is answered within a step, not a frame.
+    let advance = |scene: &mut Scene, n: u64| -> Result<()> {
+        for _ in 0..n {
+            if interrupt::requested() {
+                let sim = &scene.simulation;
+                return Err(Interrupted {
+                    step: sim.steps(),
+                    time: sim.time(),
+                }
+                .into());
+            }
+            scene.simulation.step()?;
+        }
+        Ok(())
+    };
     on_frame(0, scene)?;
     for frame in 1..=steps / every {
-        scene.simulation.advance(every)?;
+        advance(scene, every)?;
         on_frame(frame, scene)?;
         progress.set_position(scene.simulation.steps());
     }
     // Steps past the last full frame are still run: the run's length is what was asked for.
-    scene.simulation.advance(steps % every)?;
+    advance(scene, steps % every)?;
     progress.finish_and_clear();
     Ok(())
 }
 
 fn is_divergence(e: &anyhow::Error) -> bool {
     e.downcast_ref::<Divergence>().is_some()
+}
+
+fn is_interrupt(e: &anyhow::Error) -> bool {
+    e.downcast_ref::<Interrupted>().is_some()
 }
 
 /// Warns on stderr when the scene's step exceeds the estimated stable step.
@@ -115,14 +135,24 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         }
         Ok(())
     });
-    // After a divergence the frames already written are complete and are kept.
-    if result.is_ok() || result.as_ref().is_err_and(is_divergence) {
+    // After a divergence or Ctrl-C the frames already written are complete and are kept.
+    let kept = |e: &anyhow::Error| is_divergence(e) || is_interrupt(e);
+    if result.is_ok() || result.as_ref().is_err_and(kept) {
         if let Some(t) = trajectory {
             t.finish()?;
         }
         if let Some(f) = frames {
             f.finish()?;
         }
+    }
+    if let Err(e) = &result
+        && is_interrupt(e)
+    {
+        eprintln!("{e}: stopped; files end at the last complete frame");
+        if let Some(path) = &args.trajectory {
+            eprintln!("trajectory: {}", path.display());
+        }
+        return Ok(ExitCode::from(interrupt::EXIT_INTERRUPTED));
     }
     result?;
     let sim = &scene.simulation;

@@ -271,3 +271,69 @@ fn the_table_can_be_swapped_from_the_command_line() {
     assert!(!out.status.success());
     assert!(stderr(&out).contains("has no table"), "{}", stderr(&out));
 }
+
+/// Ctrl-C stops a long run cleanly: exit status 130, the trajectory ends at a complete frame,
+/// every frame PNG decodes, and no temporary file is left.
+#[test]
+fn ctrl_c_stops_a_run_at_a_complete_frame() {
+    let dir = scratch("sigint");
+    let child = Command::new(env!("CARGO_BIN_EXE_hooke"))
+        .args([
+            "run",
+            "chain",
+            "--duration",
+            "100000",
+            "--every",
+            "200",
+            "--trajectory",
+            "t.csv",
+            "--frames",
+            "frames",
+            "--size",
+            "64x48",
+        ])
+        .current_dir(&dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Let it write some frames, then interrupt.
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("interrupted at step"),
+        "{}",
+        stderr(&out)
+    );
+
+    let csv = std::fs::read_to_string(dir.join("t.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    // The chain has 12 particles: whole frames only, each row complete.
+    assert!(rows.len() >= 12, "some frames were written");
+    assert_eq!(
+        rows.len() % 12,
+        0,
+        "{} rows is not whole frames",
+        rows.len()
+    );
+    assert!(rows.iter().all(|r| r.split(',').count() == 9));
+    let frames: Vec<_> = std::fs::read_dir(dir.join("frames"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(frames.len(), rows.len() / 12);
+    for f in &frames {
+        image::open(f).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+    }
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+}

@@ -52,7 +52,7 @@ impl Placement {
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
     /// The file could not be read.
-    #[error("cannot read mesh {path}: {source}")]
+    #[error("cannot read mesh {path}")]
     Io {
         /// The file.
         path: PathBuf,
@@ -66,6 +66,19 @@ pub enum MeshError {
         path: PathBuf,
         /// tobj's reason.
         reason: String,
+    },
+    /// A vertex coordinate is NaN or infinite.
+    /// A malformed `v` or `f` line.
+    #[error("{path}:{line}: {reason}: '{text}'")]
+    Line {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What was expected.
+        reason: String,
+        /// The line.
+        text: String,
     },
     /// A vertex coordinate is NaN or infinite.
     #[error("{path}:{line}: vertex coordinate is not a finite number: '{text}'")]
@@ -125,19 +138,64 @@ pub fn parse_obj(
     path: &Path,
     placement: &Placement,
 ) -> Result<Vec<MeshPart>, MeshError> {
-    // tobj parses NaN happily and reports no lines, so finiteness is checked here, with one.
+    // tobj parses NaN happily and reports no lines, so vertices and faces are checked here
+    // first, each error with its line.
+    let vertices = text
+        .lines()
+        .filter(|l| l.split_whitespace().next() == Some("v"))
+        .count();
     for (n, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
-        if words.next() == Some("v")
-            && words
-                .take(3)
-                .any(|w| w.parse::<f64>().is_ok_and(|x| !x.is_finite()))
-        {
-            return Err(MeshError::NonFinite {
-                path: path.to_path_buf(),
-                line: n + 1,
-                text: line.trim().to_string(),
-            });
+        let bad = |reason: String| MeshError::Line {
+            path: path.to_path_buf(),
+            line: n + 1,
+            reason,
+            text: line.trim().to_string(),
+        };
+        match words.next() {
+            Some("v") => {
+                let coordinates: Vec<&str> = words.take(3).collect();
+                if coordinates.len() < 3 {
+                    return Err(bad("a vertex needs x, y and z".into()));
+                }
+                for w in coordinates {
+                    match w.parse::<f64>() {
+                        Ok(x) if x.is_finite() => {}
+                        Ok(_) => {
+                            return Err(MeshError::NonFinite {
+                                path: path.to_path_buf(),
+                                line: n + 1,
+                                text: line.trim().to_string(),
+                            });
+                        }
+                        Err(_) => return Err(bad(format!("'{w}' is not a number"))),
+                    }
+                }
+            }
+            Some("f") => {
+                let corners: Vec<&str> = words.collect();
+                if corners.len() < 3 {
+                    return Err(bad(format!(
+                        "a face needs at least 3 vertices, found {}",
+                        corners.len()
+                    )));
+                }
+                for c in corners {
+                    let index = c.split('/').next().unwrap_or("");
+                    let valid = match index.parse::<i64>() {
+                        Ok(i) if i > 0 => i as usize <= vertices,
+                        // Negative indices count back from the vertices read so far.
+                        Ok(i) if i < 0 => i.unsigned_abs() as usize <= vertices,
+                        _ => false,
+                    };
+                    if !valid {
+                        return Err(bad(format!(
+                            "face vertex '{c}' does not name one of the file's {vertices} vertices"
+                        )));
+                    }
+                }
+            }
+            _ => {}
         }
     }
     let options = tobj::LoadOptions {

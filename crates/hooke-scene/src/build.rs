@@ -38,8 +38,8 @@ pub enum BuildError {
         /// What is wrong and what was expected.
         message: String,
     },
-    /// A mesh could not be loaded.
-    #[error("{key}: {source}")]
+    /// A mesh could not be loaded (the mesh error follows in the error's chain).
+    #[error("{key}")]
     Mesh {
         /// Where in the scene.
         key: String,
@@ -322,7 +322,10 @@ impl SceneSpec {
         let mut geometry = Vec::new();
         for (c, spec) in self.colliders.iter().enumerate() {
             let key = format!("collider[{c}]");
-            let (shape, geo) = build_collider(&spec.shape, &key, base, &centroid)?;
+            // Penalty forces need an inside: a mesh under one must be a closed solid. The
+            // velocity responses also catch crossings, so open sheets work with them.
+            let solid = matches!(spec.response, ResponseSpec::Penalty { .. });
+            let (shape, geo) = build_collider(&spec.shape, &key, base, &centroid, solid)?;
             let response = match spec.response {
                 ResponseSpec::Penalty { kc, dc } => Response::Penalty { kc: kc.0, dc: dc.0 },
                 ResponseSpec::Restitution { cr, friction } => Response::Restitution {
@@ -524,6 +527,7 @@ fn build_collider(
     key: &str,
     base: &Path,
     centroid: &Vec3,
+    solid: bool,
 ) -> Result<(Box<dyn Collider>, ColliderGeometry), BuildError> {
     Ok(match shape {
         ColliderShapeSpec::Ground { height } => (
@@ -579,7 +583,7 @@ fn build_collider(
             let mesh = || -> Result<TriMeshCollider, MeshError> {
                 let (text, full) = mesh_text(path, base)?;
                 let parts = hooke_collide::parse_obj(&text, &full, &placement)?;
-                TriMeshCollider::new(format!("mesh {path}"), parts, &full, false)
+                TriMeshCollider::new(format!("mesh {path}"), parts, &full, solid)
             };
             let mesh = mesh().map_err(|source| BuildError::Mesh {
                 key: format!("{key}.shape.path"),

@@ -34,7 +34,7 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The file could not be read.
-    #[error("cannot read scene {path}: {source}")]
+    #[error("cannot read scene {path}")]
     Io {
         /// The file.
         path: PathBuf,

@@ -68,7 +68,7 @@ pub struct World {
 #[derive(Debug, thiserror::Error)]
 pub enum WorldError {
     /// The file could not be read.
-    #[error("cannot read world {path}: {source}")]
+    #[error("cannot read world {path}")]
     Io {
         /// The file.
         path: PathBuf,
