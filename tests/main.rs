@@ -9,5 +9,6 @@ mod conservation;
 mod determinism;
 mod images;
 mod oscillator;
+mod roundtrip;
 mod scenes;
 mod worlds;

@@ -137,8 +137,8 @@ fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
 }
 
 fn workload(n: usize, steps: u64, integrator: Integrator) -> Result<Scene> {
-    if !(3..=4096).contains(&n) {
-        bail!("--n: expected a cloth size from 3 to 4096, found {n}");
+    if !(3..=2048).contains(&n) {
+        bail!("--n: expected a cloth size from 3 to 2048, found {n}");
     }
     if steps == 0 {
         bail!("--steps: expected at least 1");

@@ -24,8 +24,17 @@ impl AtomicFile {
         temp_name.push(name);
         temp_name.push(format!(".{}.tmp", std::process::id()));
         let temp = target.with_file_name(temp_name);
-        let file =
-            File::create(&temp).with_context(|| format!("cannot create {}", temp.display()))?;
+        let file = File::create(&temp).with_context(|| {
+            let dir = target
+                .parent()
+                .filter(|d| !d.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            format!(
+                "cannot write {}: cannot create a file in {}",
+                target.display(),
+                dir.display()
+            )
+        })?;
         Ok(Self {
             target: target.to_path_buf(),
             temp,

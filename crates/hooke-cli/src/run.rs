@@ -81,9 +81,91 @@ fn warn_if_unstable(scene: &Scene) -> StabilityEstimate {
     estimate
 }
 
+/// One thin collider against the fastest motion the scene can reach.
+struct Tunnelling {
+    collider: String,
+    thickness: f64,
+    speed: f64,
+    drop: f64,
+    per_step: f64,
+    /// The largest step that keeps a step's travel within half the thickness.
+    safe_dt: f64,
+}
+
+/// For every collider with a finite thickness: how far the fastest particle moves in one
+/// step. The speed is the larger of the fastest particle now and a free fall from the
+/// highest particle to the ground (or the lowest particle): what a falling cloth reaches.
+fn tunnelling(scene: &Scene) -> Vec<Tunnelling> {
+    let sim = &scene.simulation;
+    let p = sim.particles();
+    let model = sim.model();
+    let top = p.x.iter().map(|x| x.y).fold(f64::NEG_INFINITY, f64::max);
+    let mut bottom = p.x.iter().map(|x| x.y).fold(f64::INFINITY, f64::min);
+    for c in &scene.colliders {
+        if let hooke_scene::ColliderGeometry::Ground(h) = c {
+            bottom = bottom.min(*h);
+        }
+    }
+    let drop = (top - bottom).max(0.0);
+    let fall = (2.0 * model.gravity.norm() * drop).sqrt();
+    let now = p.v.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    let speed = fall.max(now);
+    model
+        .colliders
+        .iter()
+        .filter_map(|slot| {
+            let thickness = slot.shape.thickness()?;
+            Some(Tunnelling {
+                collider: slot.shape.name(),
+                thickness,
+                speed,
+                drop,
+                per_step: speed * sim.dt(),
+                safe_dt: if speed > 0.0 {
+                    0.5 * thickness / speed
+                } else {
+                    f64::INFINITY
+                },
+            })
+        })
+        .collect()
+}
+
+impl Tunnelling {
+    fn risky(&self) -> bool {
+        self.per_step > 0.5 * self.thickness
+    }
+
+    fn describe(&self, dt: f64) -> String {
+        format!(
+            "{} is {:.1} mm thick at its thinnest; at {:.2} m/s (a fall of {:.2} m) a particle moves \
+             {:.1} mm per step of {dt} s",
+            self.collider,
+            self.thickness * 1e3,
+            self.speed,
+            self.drop,
+            self.per_step * 1e3
+        )
+    }
+}
+
+/// Warns on stderr about thin colliders a particle can cross in one step.
+fn warn_if_tunnelling(scene: &Scene) {
+    let dt = scene.simulation.dt();
+    for t in tunnelling(scene).iter().filter(|t| t.risky()) {
+        eprintln!(
+            "warning: {}: more than half its thickness, so a particle can pass through or be \
+             pushed out the far side (tunnelling); use dt below {:.3e} s",
+            t.describe(dt),
+            t.safe_dt
+        );
+    }
+}
+
 pub fn run(args: &RunArgs) -> Result<ExitCode> {
     let mut scene = source::build(&args.scene, &args.setup.overrides())?;
     warn_if_unstable(&scene);
+    warn_if_tunnelling(&scene);
     let mut trajectory = args
         .trajectory
         .as_deref()
@@ -213,6 +295,22 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
             println!(
                 "  {:<11} stable for any dt (accuracy still wants small steps){mark}",
                 integrator.name()
+            );
+        }
+    }
+    let dt = sim.dt();
+    for t in tunnelling(&scene) {
+        if t.risky() {
+            println!(
+                "warning: tunnelling: {}; keep dt below {:.3e} s",
+                t.describe(dt),
+                t.safe_dt
+            );
+        } else {
+            println!(
+                "thin collider: {}: no tunnelling below dt = {:.3e} s",
+                t.describe(dt),
+                t.safe_dt
             );
         }
     }

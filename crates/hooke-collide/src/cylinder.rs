@@ -33,6 +33,10 @@ impl Collider for Cylinder {
         "cylinder".to_string()
     }
 
+    fn thickness(&self) -> Option<f64> {
+        Some(self.thickness.min(2.0 * self.radius))
+    }
+
     fn contacts(&self, p: &Vec3, sink: &mut dyn FnMut(Contact)) {
         let (dx, dz) = (p.x - self.center.x, p.z - self.center.z);
         let r2 = dx * dx + dz * dz;

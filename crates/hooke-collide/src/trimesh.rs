@@ -172,6 +172,19 @@ impl Collider for TriMeshCollider {
         self.label.clone()
     }
 
+    /// The smallest side of the closed parts' bounding boxes: the table top's 4 cm for the
+    /// shipped tables.
+    fn thickness(&self) -> Option<f64> {
+        self.parts
+            .iter()
+            .filter(|p| p.closed)
+            .map(|p| {
+                let e = p.aabb.maxs - p.aabb.mins;
+                e.x.min(e.y).min(e.z)
+            })
+            .reduce(f64::min)
+    }
+
     fn contacts(&self, p: &Vec3, sink: &mut dyn FnMut(Contact)) {
         for part in self
             .parts

@@ -34,6 +34,13 @@ pub trait Collider: Debug + Send + Sync {
         None
     }
 
+    /// The thinnest extent of the solid in metres, for the tunnelling check: a particle that
+    /// moves more than half of it in one step can end nearer the far side and be pushed out
+    /// there. `None` for half-spaces and for open sheets (which the crossing test guards).
+    fn thickness(&self) -> Option<f64> {
+        None
+    }
+
     /// Whether `p` is inside.
     fn inside(&self, p: &Vec3) -> bool {
         let mut any = false;

@@ -11,9 +11,24 @@ use nalgebra::Rotation3;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-/// Most particles a scene may have: beyond this a typo (an extra zero in a size) would
-/// exhaust memory before anything useful happened.
-pub const MAX_PARTICLES: usize = 20_000_000;
+/// Most particles a scene may have (2048²): beyond this a typo (an extra zero in a size)
+/// would exhaust memory before anything useful happened. A lattice this large carries about
+/// 13 springs per particle, some 3 GB with the solver's buffers.
+pub const MAX_PARTICLES: usize = 1 << 22;
+
+/// Most steps a run may take: a billion steps is half an hour of the 12-bead chain and days
+/// of the cloth on the table; more is a mistake in `steps`, `duration` or `dt`.
+pub const MAX_STEPS: u64 = 1_000_000_000;
+
+/// Particles a shape will have, or `None` when the count overflows.
+fn particle_count(shape: &ShapeSpec) -> Option<usize> {
+    match shape {
+        ShapeSpec::Chain { count, .. } => Some(*count),
+        ShapeSpec::Grid { size, .. } => size[0].checked_mul(size[1]),
+        ShapeSpec::Lattice { size, .. } => size[0].checked_mul(size[1])?.checked_mul(size[2]),
+        ShapeSpec::Points { positions } => Some(positions.len()),
+    }
+}
 
 /// Meshes shipped inside Hooke, addressable as `builtin:NAME` from any scene file.
 pub const BUILTIN_MESHES: [(&str, &str); 2] = [
@@ -216,14 +231,18 @@ impl SceneSpec {
                 "expected `steps` or `duration` (the length of the run)",
             )),
             (Some(0), None) => Err(invalid("simulation.steps", "expected at least 1 step")),
+            (Some(n), None) if n > MAX_STEPS => Err(invalid(
+                "simulation.steps",
+                format!("expected at most {MAX_STEPS} steps, found {n}"),
+            )),
             (Some(n), None) => Ok(n),
             (None, Some(t)) => {
                 let n = (t.0 / sim.dt.0).round();
-                if !(1.0..=1e15).contains(&n) {
+                if !(1.0..=MAX_STEPS as f64).contains(&n) {
                     Err(invalid(
                         "simulation.duration",
                         format!(
-                            "{} s at dt = {} s is {n} steps; expected 1 to 1e15",
+                            "{} s at dt = {} s is {n:.3e} steps; expected 1 to {MAX_STEPS}",
                             t.0, sim.dt.0
                         ),
                     ))
@@ -250,14 +269,18 @@ impl SceneSpec {
         let mut bodies = Vec::new();
         for (b, body) in self.bodies.iter().enumerate() {
             let key = format!("body[{b}] '{}'", body.name);
-            let built = build_body(body, &key, particles.len())?;
             let start = particles.len();
-            if start + built.local.len() > MAX_PARTICLES {
+            // Checked before anything is allocated.
+            if particle_count(&body.shape)
+                .and_then(|n| n.checked_add(start))
+                .is_none_or(|n| n > MAX_PARTICLES)
+            {
                 return Err(invalid(
-                    &key,
+                    format!("{key}.shape"),
                     format!("the scene would have more than {MAX_PARTICLES} particles"),
                 ));
             }
+            let built = build_body(body, &key, particles.len())?;
             let r = rotation(&body.rotate);
             let o = vec3(&body.origin);
             let n = built.local.len();
