@@ -11,6 +11,17 @@ pub fn root() -> PathBuf {
         .unwrap()
 }
 
+/// `spec` switched to `integrator`.
+pub fn with_integrator(mut spec: SceneSpec, integrator: hooke_core::Integrator) -> SceneSpec {
+    Overrides {
+        integrator: Some(integrator),
+        ..Overrides::default()
+    }
+    .apply(&mut spec)
+    .unwrap();
+    spec
+}
+
 /// A built-in scene, with overrides, built.
 pub fn builtin(name: &str, overrides: &Overrides) -> Scene {
     let mut spec: SceneSpec = hooke_scene::builtin::builtin(name).unwrap();

@@ -30,13 +30,7 @@ fn a_free_spinning_jelly_conserves_momentum() {
             .collect(),
     );
     for integrator in Integrator::ALL {
-        let mut s = spec.clone();
-        Overrides {
-            integrator: Some(integrator),
-            ..Overrides::default()
-        }
-        .apply(&mut s)
-        .unwrap();
+        let s = crate::common::with_integrator(spec.clone(), integrator);
         let mut scene = s.build(std::path::Path::new(".")).unwrap();
         let p0 = momentum(scene.simulation.particles());
         scene.simulation.advance(2000).unwrap();

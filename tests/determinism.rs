@@ -1,7 +1,7 @@
 //! Bit-identical results whatever the thread count: forces are reduced in an order fixed by
 //! the problem, contacts are resolved per particle, pixels are written once per tile.
 
-use crate::common::builtin;
+use crate::common::{builtin, with_integrator};
 use hooke_core::{Integrator, Vec3};
 use hooke_scene::{Overrides, Scene};
 
@@ -25,13 +25,7 @@ fn cloth_workload_is_bit_identical_on_one_two_and_three_threads() {
     for integrator in Integrator::ALL {
         let run = |threads| {
             on_threads(threads, || {
-                let mut spec = hooke_scene::workload::cloth(100);
-                Overrides {
-                    integrator: Some(integrator),
-                    ..Overrides::default()
-                }
-                .apply(&mut spec)
-                .unwrap();
+                let spec = with_integrator(hooke_scene::workload::cloth(100), integrator);
                 let mut scene = spec.build(std::path::Path::new(".")).unwrap();
                 scene.simulation.advance(50).unwrap();
                 state(&scene)

@@ -88,24 +88,27 @@ fn check(name: &str, actual: &RgbaImage) -> Option<String> {
         save(&golden_path, actual);
         return None;
     }
+    // A golden that cannot be compared: keep the new image for review (off CI) and fail.
+    let unusable = |message: String| {
+        if let Update::New = mode {
+            save(&new_path, actual);
+        }
+        Some(format!(
+            "{message}; the new still is {}",
+            new_path.display()
+        ))
+    };
     let golden = match image::open(&golden_path) {
         Ok(g) => g.to_rgba8(),
         Err(e) => {
-            if let Update::New = mode {
-                save(&new_path, actual);
-            }
-            return Some(format!(
-                "{name}: no golden at {} ({e}); wrote {} unless CI is set",
-                golden_path.display(),
-                new_path.display()
+            return unusable(format!(
+                "{name}: no golden at {} ({e})",
+                golden_path.display()
             ));
         }
     };
     if golden.dimensions() != actual.dimensions() {
-        if let Update::New = mode {
-            save(&new_path, actual);
-        }
-        return Some(format!(
+        return unusable(format!(
             "{name}: golden is {:?} pixels, the still is {:?}",
             golden.dimensions(),
             actual.dimensions()

@@ -68,7 +68,7 @@ enum Command {
 /// Options that change what is simulated.
 #[derive(Args, Clone, Default)]
 struct SetupArgs {
-    /// Integrator: euler, symplectic, midpoint or rk4.
+    /// Integrator: euler, symplectic, midpoint, rk4 or implicit.
     #[arg(long)]
     integrator: Option<Integrator>,
     /// Step size in seconds.

@@ -337,3 +337,68 @@ fn ctrl_c_stops_a_run_at_a_complete_frame() {
         .collect();
     assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
 }
+
+/// `--frames` writes one PNG per frame and `--gif` an animation with as many frames, each
+/// showing the chain (not a blank image), and `render` writes the asked size.
+#[test]
+fn run_writes_frame_pngs_and_a_gif_and_render_a_still() {
+    use image::AnimationDecoder;
+    let dir = scratch("frames");
+    let out = hooke(
+        &[
+            "run",
+            "chain",
+            "--duration",
+            "1",
+            "--every",
+            "1000",
+            "--frames",
+            "f",
+            "--gif",
+            "a.gif",
+            "--size",
+            "96x72",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    // 1 s at dt = 2e-4 is 5000 steps: frames 0 to 5.
+    let pngs = std::fs::read_dir(dir.join("f")).unwrap().count();
+    assert_eq!(pngs, 6);
+    let first = image::open(dir.join("f/frame-00000.png"))
+        .unwrap()
+        .to_rgba8();
+    assert_eq!(first.dimensions(), (96, 72));
+    let background = *first.get_pixel(0, 0);
+    assert!(
+        first.pixels().filter(|p| **p != background).count() > 100,
+        "the frame shows something besides the background"
+    );
+    let gif = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(
+        std::fs::File::open(dir.join("a.gif")).unwrap(),
+    ))
+    .unwrap();
+    assert_eq!(gif.into_frames().count(), 6);
+
+    let out = hooke(
+        &[
+            "render",
+            "jello-cube",
+            "--at",
+            "0.2",
+            "-o",
+            "s.png",
+            "--size",
+            "120x90",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(
+        image::open(dir.join("s.png"))
+            .unwrap()
+            .to_rgba8()
+            .dimensions(),
+        (120, 90)
+    );
+}
