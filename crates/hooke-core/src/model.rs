@@ -2,7 +2,6 @@
 
 use crate::collider::{Collider, Contact};
 use crate::force_field::ForceField;
-use crate::parallel;
 use crate::particles::Vec3;
 use crate::response::Response;
 use crate::spring::Spring;
@@ -85,17 +84,29 @@ impl Model {
 
     /// Applies the velocity-level responses (restitution, stick) after a full step. `x0` are
     /// the positions at the start of the step, for the crossing test of thin colliders.
-    pub fn resolve_contacts(&self, inv_mass: &[f64], x0: &[Vec3], x: &mut [Vec3], v: &mut [Vec3]) {
+    ///
+    /// `stuck` records, per particle, whether it is held by a stick response: set when one
+    /// resolved it this step, kept while it has not moved since (the implicit integrator
+    /// holds stuck particles in place, so they are not re-detected). Explicit integrators
+    /// ignore it.
+    pub fn resolve_contacts(
+        &self,
+        inv_mass: &[f64],
+        x0: &[Vec3],
+        x: &mut [Vec3],
+        v: &mut [Vec3],
+        stuck: &mut [bool],
+    ) {
         if self.colliders.iter().all(|c| c.response.is_force()) {
             return;
         }
-        // Mesh queries cost microseconds each, so even small blocks are worth sharing.
-        parallel::for_blocks(CONTACT_BLOCK, x, v, |start, x, v| {
+        let resolve = |start: usize, x: &mut [Vec3], v: &mut [Vec3], stuck: &mut [bool]| {
             for k in 0..x.len() {
                 let p = start + k;
                 if inv_mass[p] == 0.0 {
                     continue;
                 }
+                let mut held = stuck[k] && x[k] == x0[p];
                 for slot in self.colliders.iter().filter(|c| !c.response.is_force()) {
                     let here = x[k];
                     let mut touched = false;
@@ -104,11 +115,25 @@ impl Model {
                         slot.response.resolve(&c, &mut x[k], &mut v[k]);
                     });
                     if !touched && let Some(c) = slot.shape.crossing(&x0[p], &here) {
+                        touched = true;
                         slot.response.resolve(&c, &mut x[k], &mut v[k]);
                     }
+                    held |= touched && matches!(slot.response, Response::Stick);
                 }
+                stuck[k] = held;
             }
-        });
+        };
+        // Mesh queries cost microseconds each, so even small blocks are worth sharing.
+        if x.len() <= CONTACT_BLOCK {
+            resolve(0, x, v, stuck);
+        } else {
+            use rayon::prelude::*;
+            x.par_chunks_mut(CONTACT_BLOCK)
+                .zip(v.par_chunks_mut(CONTACT_BLOCK))
+                .zip(stuck.par_chunks_mut(CONTACT_BLOCK))
+                .enumerate()
+                .for_each(|(b, ((x, v), s))| resolve(b * CONTACT_BLOCK, x, v, s));
+        }
     }
 
     /// Total potential energy in joules: springs, gravity (zero at the origin) and penalty

@@ -124,8 +124,9 @@ impl Simulation {
             &mut self.workspace,
         );
         let p = &mut self.particles;
+        let ws = &mut self.workspace;
         self.model
-            .resolve_contacts(&p.inv_mass, &self.workspace.x0, &mut p.x, &mut p.v);
+            .resolve_contacts(&p.inv_mass, &ws.x0, &mut p.x, &mut p.v, &mut ws.stuck);
         self.step += 1;
         self.check()
     }

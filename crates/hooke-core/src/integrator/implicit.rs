@@ -8,9 +8,11 @@
 //!
 //! then `v' = v + Δv`, `x' = x + dt v'`. The matrix is symmetric positive definite and never
 //! assembled: CG multiplies by it spring by spring through the same fixed-order partitions
-//! as the forces, so results are bit-identical on any thread count. Pinned particles are
-//! filtered out of the system (their rows and columns are zero, `Δv = 0`). The force field
-//! and penalty colliders enter through `f₀` only: their derivatives are not linearised.
+//! as the forces, so results are bit-identical on any thread count. Pinned particles, and
+//! particles held by a stick response, are filtered out of the system (their rows and
+//! columns are zero, `Δv = 0`): Baraff and Witkin's constraint filter, which keeps a
+//! tablecloth's stuck particles from being dragged through the top by long steps. The force
+//! field and penalty colliders enter through `f₀` only: their derivatives are not linearised.
 
 use super::Workspace;
 use crate::assembly::Sym3;
@@ -41,6 +43,9 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
     ws.x0.copy_from_slice(&p.x);
     let buffers = &mut ws.implicit;
     let asm = &mut ws.assembly;
+    let stuck = &ws.stuck;
+    let inv_mass = &p.inv_mass;
+    let fixed = |i: usize| inv_mass[i] == 0.0 || stuck[i];
 
     // Forces at the current state.
     let [f0, b, dv, r] = &mut ws.kv;
@@ -67,10 +72,10 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
         asm.scatter_pairs(|k, i, j| blocks[k][0].mul(&(v[i] - v[j])));
     }
     {
-        let (asm, inv_mass) = (&*asm, &p.inv_mass);
+        let asm = &*asm;
         let f0 = &*f0;
         parallel::for_each(b, |i, b| {
-            *b = if inv_mass[i] == 0.0 {
+            *b = if fixed(i) {
                 Vec3::zeros()
             } else {
                 (f0[i] - asm.spring_force(i) * dt) * dt
@@ -90,7 +95,7 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
         buffers.preconditioner[j] = buffers.preconditioner[j].plus(c);
     }
     for (i, m) in buffers.preconditioner.iter_mut().enumerate() {
-        *m = if p.inv_mass[i] == 0.0 {
+        *m = if fixed(i) {
             Sym3::default()
         } else {
             m.inverse().unwrap_or_default()
@@ -100,12 +105,12 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
     // Preconditioned CG on A Δv = b, A = M + dt·drag + Σ system blocks, pinned rows filtered.
     let [d, q, z, _] = &mut ws.kx;
     let system = &buffers.system;
-    let (mass, inv_mass) = (&p.mass, &p.inv_mass);
+    let mass = &p.mass;
     let multiply = |asm: &mut crate::Assembly, from: &[Vec3], to: &mut [Vec3]| {
         asm.scatter_pairs(|k, i, j| system[k].mul(&(from[i] - from[j])));
         let asm = &*asm;
         parallel::for_each(to, |i, t| {
-            *t = if inv_mass[i] == 0.0 {
+            *t = if fixed(i) {
                 Vec3::zeros()
             } else {
                 from[i] * (mass[i] + diagonal_shift) + asm.spring_force(i)
@@ -153,14 +158,13 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
     // explicit schemes do, at a cost below the CG tolerance.
     let residual: Vec3 = r.iter().sum();
     let free_mass: f64 = (0..n)
-        .filter(|&i| p.inv_mass[i] != 0.0)
+        .filter(|&i| !fixed(i))
         .map(|i| p.mass[i] + diagonal_shift)
         .sum();
     if free_mass > 0.0 {
         let shift = residual / free_mass;
-        let inv_mass = &p.inv_mass;
         parallel::for_each(dv, |i, dv| {
-            if inv_mass[i] != 0.0 {
+            if !fixed(i) {
                 *dv += shift;
             }
         });

@@ -128,6 +128,8 @@ pub struct Workspace {
     pub(crate) vt: Vec<Vec3>,
     /// The implicit integrator's blocks and preconditioner.
     pub(crate) implicit: implicit::ImplicitBuffers,
+    /// Particles held by a stick response (see [`Model::resolve_contacts`]).
+    pub(crate) stuck: Vec<bool>,
 }
 
 impl Workspace {
@@ -142,6 +144,7 @@ impl Workspace {
             self.assembly = Assembly::new(particles, &model.springs);
         }
         let zero = Vec3::zeros();
+        self.stuck.resize(particles, false);
         for buf in [&mut self.x0, &mut self.v0, &mut self.xt, &mut self.vt]
             .into_iter()
             .chain(self.kx.iter_mut())
