@@ -2,9 +2,9 @@
 //! in a fixed order.
 //!
 //! Springs are sorted by their lower particle index (ties keep the model's order) and cut
-//! into partitions of consecutive springs (their size set by the spring count alone). Each partition
-//! scatters its forces into a private buffer covering only the particles it touches (its
-//! *window*); a second pass gives each particle the sum of its external force and of every
+//! into partitions of consecutive springs, their size set by the spring count alone. Each
+//! partition scatters its forces into a private buffer covering only the particles it
+//! touches (its *window*); a second pass gives each particle the sum of its external force and of every
 //! window holding it, in partition order. Partitions and reduction blocks are fixed by the
 //! problem's size, never by the thread count, so the sums are the same bits on any number
 //! of threads, with no atomics. Sorted springs of a mesh touch narrow windows, so the
