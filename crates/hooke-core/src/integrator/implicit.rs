@@ -32,7 +32,7 @@ pub struct ImplicitBuffers {
     blocks: Vec<[Sym3; 2]>,
     /// Per spring: `dt² K + dt D`.
     system: Vec<Sym3>,
-    /// Per particle: the inverse diagonal block of the system (zero for pinned particles).
+    /// Per particle: the inverse diagonal block of the system (zero for filtered particles).
     preconditioner: Vec<Sym3>,
     /// CG iterations of the last step.
     pub(crate) iterations: usize,
@@ -66,7 +66,7 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
             .map(|[k, d]| k.scale(dt * dt).plus(&d.scale(dt))),
     );
 
-    // Right-hand side b = dt (f0 - dt K v0), zero at pinned particles.
+    // Right-hand side b = dt (f0 - dt K v0), zero at filtered particles.
     {
         let (blocks, v) = (&buffers.blocks, &p.v);
         asm.scatter_pairs(|k, i, j| blocks[k][0].mul(&(v[i] - v[j])));
@@ -102,7 +102,7 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
         };
     }
 
-    // Preconditioned CG on A Δv = b, A = M + dt·drag + Σ system blocks, pinned rows filtered.
+    // Preconditioned CG on A Δv = b, A = M + dt·drag + Σ system blocks, pinned and stuck rows filtered.
     let [d, q, z, _] = &mut ws.kx;
     let system = &buffers.system;
     let mass = &p.mass;
