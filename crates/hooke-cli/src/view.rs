@@ -11,6 +11,7 @@ use crate::image_out::write_png;
 use crate::source;
 use anyhow::{Context, Result};
 use font8x8::UnicodeFonts;
+use hooke_cli::interrupt;
 use hooke_core::{Attachment, SpringKind, Vec3};
 use hooke_render::{Camera, RenderOptions, Renderer};
 use hooke_scene::{Overrides, Scene};
@@ -330,7 +331,7 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
     let (mut sim_time, mut render_time) = (Duration::ZERO, Duration::ZERO);
     let mut fps = 0.0;
     let mut window_start = (Instant::now(), 0u64);
-    while window.is_open() && !window.is_key_down(Key::Escape) {
+    while window.is_open() && !window.is_key_down(Key::Escape) && !interrupt::requested() {
         let now = Instant::now();
         let wall = (now - last).as_secs_f64().min(0.25);
         last = now;

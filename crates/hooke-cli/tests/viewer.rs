@@ -19,13 +19,20 @@ fn available(program: &str) -> bool {
         .is_ok_and(|s| s.success())
 }
 
-/// Kills the child when dropped, so a failing assertion leaves no X server behind.
+/// Stops the child when dropped, so a failing assertion leaves no X server behind. SIGTERM
+/// first: a killed Xvfb leaves its lock and socket files behind.
 struct Reaper(Child);
 
 impl Drop for Reaper {
     fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
+        let _ = Command::new("kill")
+            .args(["-TERM", &self.0.id().to_string()])
+            .status();
+        let stopped = until(Duration::from_secs(5), || self.0.try_wait().ok().flatten());
+        if stopped.is_none() {
+            let _ = self.0.kill();
+            let _ = self.0.wait();
+        }
     }
 }
 
@@ -96,10 +103,19 @@ fn viewer_animates_and_tab_switches_scenes_under_xvfb() {
             .spawn()
             .unwrap(),
     );
-    let window = until(Duration::from_secs(20), || {
+    let window = until(Duration::from_secs(30), || {
         xdotool(&display, &["search", "--name", "^hooke$"]).filter(|id| !id.is_empty())
-    })
-    .expect("no viewer window appeared");
+    });
+    let Some(window) = window else {
+        let _ = viewer.0.kill();
+        let out = std::mem::replace(&mut viewer.0, Command::new("true").spawn().unwrap())
+            .wait_with_output()
+            .unwrap();
+        panic!(
+            "no viewer window appeared on {display}; viewer said: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
     let window = window.lines().next().unwrap().to_string();
     xdotool(&display, &["windowfocus", "--sync", &window]).expect("focus the window");
 
