@@ -112,6 +112,9 @@ pub(crate) struct TriSetup {
     pub src: u32,
     /// Whether corners 1 and 2 were exchanged to make the area positive.
     pub swapped: bool,
+    /// At most 2×2 samples across (a pixel or less at 4× AA): shaded with its mean corner
+    /// normal, as interpolating inside it changes nothing visible.
+    pub tiny: bool,
     pub rect: Rect,
 }
 
@@ -162,6 +165,7 @@ impl TriSetup {
             area,
             src,
             swapped,
+            tiny: rect.x1 - rect.x0 <= 2 && rect.y1 - rect.y0 <= 2,
             rect,
         })
     }
