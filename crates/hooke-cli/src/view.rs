@@ -322,6 +322,9 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
     window.set_target_fps(0);
     let mut viewer = Viewer::new(scenes)?;
     let mut renderer = Renderer::default();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .build()
+        .context("cannot start the worker threads")?;
     let mut buffer = vec![0u32; w * h];
     let options = viewer.options(size, args.supersample.clamp(1, 4));
 
@@ -382,11 +385,15 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
         }
         viewer.last_mouse = mouse;
 
+        // The window stays on this thread; the work of a frame runs on a pool worker, where
+        // the solver's and rasterizer's parallel loops are cheap joins.
         let t0 = Instant::now();
-        viewer.simulate(wall);
+        pool.install(|| viewer.simulate(wall));
         let t1 = Instant::now();
-        let list = draw_with(&viewer.scene, viewer.style, |k| viewer.show(k));
-        let pixels = renderer.render(&list, &viewer.camera, &options);
+        let pixels = pool.install(|| {
+            let list = draw_with(&viewer.scene, viewer.style, |k| viewer.show(k));
+            renderer.render(&list, &viewer.camera, &options)
+        });
         for (o, p) in buffer.iter_mut().zip(pixels.chunks_exact(4)) {
             *o = (p[0] as u32) << 16 | (p[1] as u32) << 8 | p[2] as u32;
         }
