@@ -29,6 +29,27 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// `hooke run SCENE --steps N --every K --trajectory CSV` in `dir`, which must succeed;
+/// returns the trajectory's text.
+fn run_trajectory(scene: &str, steps: u64, every: u64, csv: &str, dir: &Path) -> String {
+    let (steps, every) = (steps.to_string(), every.to_string());
+    let out = hooke(
+        &[
+            "run",
+            scene,
+            "--steps",
+            &steps,
+            "--every",
+            &every,
+            "--trajectory",
+            csv,
+        ],
+        dir,
+    );
+    assert!(out.status.success(), "{scene}: {}", stderr(&out));
+    std::fs::read_to_string(dir.join(csv)).unwrap()
+}
+
 #[test]
 fn every_builtin_runs_and_writes_a_spec_trajectory() {
     let dir = scratch("builtins");
@@ -39,21 +60,7 @@ fn every_builtin_runs_and_writes_a_spec_trajectory() {
         ("hanging-cloth", 625),
         ("cloth-table", 1024),
     ] {
-        let out = hooke(
-            &[
-                "run",
-                name,
-                "--steps",
-                "205",
-                "--every",
-                "50",
-                "--trajectory",
-                "t.csv",
-            ],
-            &dir,
-        );
-        assert!(out.status.success(), "{name}: {}", stderr(&out));
-        let text = std::fs::read_to_string(dir.join("t.csv")).unwrap();
+        let text = run_trajectory(name, 205, 50, "t.csv", &dir);
         let mut lines = text.lines();
         assert_eq!(lines.next(), Some("frame,time,particle,x,y,z,vx,vy,vz"));
         // Frames 0..=4 (steps 0, 50, ..., 200): the last multiple of 50 that 205 steps reach.
@@ -80,25 +87,9 @@ fn a_printed_scene_reproduces_the_builtin_run_bit_for_bit() {
     let printed = hooke(&["scene", "cloth-table"], &dir);
     assert!(printed.status.success());
     std::fs::write(dir.join("mine.toml"), &printed.stdout).unwrap();
-    for (scene, csv) in [("cloth-table", "a.csv"), ("mine.toml", "b.csv")] {
-        let out = hooke(
-            &[
-                "run",
-                scene,
-                "--steps",
-                "400",
-                "--every",
-                "100",
-                "--trajectory",
-                csv,
-            ],
-            &dir,
-        );
-        assert!(out.status.success(), "{}", stderr(&out));
-    }
     assert_eq!(
-        std::fs::read(dir.join("a.csv")).unwrap(),
-        std::fs::read(dir.join("b.csv")).unwrap()
+        run_trajectory("cloth-table", 400, 100, "a.csv", &dir),
+        run_trajectory("mine.toml", 400, 100, "b.csv", &dir)
     );
 }
 
@@ -107,21 +98,7 @@ fn public_worlds_run_from_the_command_line() {
     let dir = scratch("worlds");
     for name in ["jello", "gravity", "moveLeft", "rotate", "skewedCorner"] {
         let world = root().join(format!("assets/worlds/{name}.w"));
-        let out = hooke(
-            &[
-                "run",
-                world.to_str().unwrap(),
-                "--steps",
-                "100",
-                "--every",
-                "50",
-                "--trajectory",
-                "t.csv",
-            ],
-            &dir,
-        );
-        assert!(out.status.success(), "{name}: {}", stderr(&out));
-        let text = std::fs::read_to_string(dir.join("t.csv")).unwrap();
+        let text = run_trajectory(world.to_str().unwrap(), 100, 50, "t.csv", &dir);
         assert_eq!(text.lines().count(), 1 + 3 * 512, "{name}");
     }
 }

@@ -12,6 +12,7 @@
 //! positions from a small, cache-resident stretch of the arrays.
 
 use crate::model::Model;
+use crate::parallel;
 use crate::particles::Vec3;
 use crate::spring::{Lanes, Spring, spring_lanes};
 use rayon::prelude::*;
@@ -163,6 +164,16 @@ struct Partition {
     force: Vec<Vec3>,
 }
 
+/// Runs `f` on every partition: in parallel when there are several, inline for one (a small
+/// system, where a rayon call would cost more than the springs).
+fn each_partition(partitions: &mut [Partition], f: impl Fn(&mut Partition) + Sync + Send) {
+    if let [only] = partitions {
+        f(only);
+    } else {
+        partitions.par_iter_mut().for_each(f);
+    }
+}
+
 /// The solver's view of a model's springs, built once per run and reused every evaluation.
 /// It copies the springs: rebuild it (a new [`crate::Workspace`]) after editing them.
 #[derive(Clone, Debug, Default)]
@@ -291,15 +302,11 @@ impl Assembly {
             }
             part.force[current - lo] += pull;
         };
-        if self.partitions.len() == 1 {
-            scatter(&mut self.partitions[0]);
-        } else {
-            self.partitions.par_iter_mut().for_each(scatter);
-        }
+        each_partition(&mut self.partitions, scatter);
     }
 
     /// Scatters an antisymmetric per-spring quantity: `g(k, i, j)` is added at the spring's
-    /// lower end `i` and subtracted at `j`; [`Assembly::spring_force`] then reads the sums.
+    /// lower end `i` and subtracted at `j`; [`Assembly::gathered`] then reads the sums.
     /// `k` indexes the assembly's own (sorted) spring order, as [`Assembly::spring_blocks`]
     /// does. This is how the implicit integrator multiplies by its system matrix.
     pub fn scatter_pairs(&mut self, g: impl Fn(usize, usize, usize) -> Vec3 + Sync) {
@@ -315,16 +322,7 @@ impl Assembly {
                 part.force[j - lo] -= f;
             }
         };
-        if self.partitions.len() == 1 {
-            scatter(&mut self.partitions[0]);
-        } else {
-            self.partitions.par_iter_mut().for_each(scatter);
-        }
-    }
-
-    /// Number of springs, in the assembly's order.
-    pub fn springs(&self) -> usize {
-        self.table.ends.len()
+        each_partition(&mut self.partitions, scatter);
     }
 
     /// The end particles `[i, j]` (lower first) of the assembly's spring `k`.
@@ -367,9 +365,10 @@ impl Assembly {
         }
     }
 
-    /// The total spring force on particle `p` from the last [`Assembly::scatter`].
+    /// The sum at particle `p` of the last scatter: its total spring force after
+    /// [`Assembly::scatter`], its row of the product after [`Assembly::scatter_pairs`].
     #[inline]
-    pub fn spring_force(&self, p: usize) -> Vec3 {
+    pub fn gathered(&self, p: usize) -> Vec3 {
         let b = p / REDUCE_BLOCK;
         let parts =
             &self.block_parts[self.block_start[b] as usize..self.block_start[b + 1] as usize];
@@ -387,7 +386,7 @@ impl Assembly {
     /// scatter at the same `(x, v)`).
     #[inline]
     pub fn force(&self, model: &Model, mass: f64, x: &Vec3, v: &Vec3, p: usize) -> Vec3 {
-        let f = model.external_force(mass, x, v) + self.spring_force(p);
+        let f = model.external_force(mass, x, v) + self.gathered(p);
         if model.attachments.is_empty() {
             f
         } else {
@@ -405,22 +404,12 @@ impl Assembly {
         a: &mut [Vec3],
     ) {
         self.scatter(x, v);
-        let gather = |start: usize, a: &mut [Vec3]| {
-            for (k, out) in a.iter_mut().enumerate() {
-                let p = start + k;
-                *out = if inv_mass[p] == 0.0 {
-                    Vec3::zeros()
-                } else {
-                    self.force(model, mass[p], &x[p], &v[p], p) * inv_mass[p]
-                };
-            }
-        };
-        if a.len() <= REDUCE_BLOCK {
-            gather(0, a);
-        } else {
-            a.par_chunks_mut(REDUCE_BLOCK)
-                .enumerate()
-                .for_each(|(b, a)| gather(b * REDUCE_BLOCK, a));
-        }
+        parallel::for_each_in(REDUCE_BLOCK, a, |p, out| {
+            *out = if inv_mass[p] == 0.0 {
+                Vec3::zeros()
+            } else {
+                self.force(model, mass[p], &x[p], &v[p], p) * inv_mass[p]
+            };
+        });
     }
 }

@@ -2,6 +2,7 @@
 
 use crate::collider::{Collider, Contact};
 use crate::force_field::ForceField;
+use crate::parallel;
 use crate::particles::Vec3;
 use crate::response::Response;
 use crate::spring::Spring;
@@ -124,16 +125,7 @@ impl Model {
             }
         };
         // Mesh queries cost microseconds each, so even small blocks are worth sharing.
-        if x.len() <= CONTACT_BLOCK {
-            resolve(0, x, v, stuck);
-        } else {
-            use rayon::prelude::*;
-            x.par_chunks_mut(CONTACT_BLOCK)
-                .zip(v.par_chunks_mut(CONTACT_BLOCK))
-                .zip(stuck.par_chunks_mut(CONTACT_BLOCK))
-                .enumerate()
-                .for_each(|(b, ((x, v), s))| resolve(b * CONTACT_BLOCK, x, v, s));
-        }
+        parallel::for_blocks3(CONTACT_BLOCK, x, v, stuck, resolve);
     }
 
     /// Total potential energy in joules: springs, gravity (zero at the origin) and penalty

@@ -26,6 +26,26 @@ pub(crate) fn for_blocks(
     }
 }
 
+/// [`for_blocks`] with a third per-particle array of any type (start positions, contact
+/// flags), for updates that write three arrays in one pass.
+pub(crate) fn for_blocks3<C: Send>(
+    block: usize,
+    a: &mut [Vec3],
+    b: &mut [Vec3],
+    c: &mut [C],
+    f: impl Fn(usize, &mut [Vec3], &mut [Vec3], &mut [C]) + Sync + Send,
+) {
+    if a.len() <= block {
+        f(0, a, b, c);
+    } else {
+        a.par_chunks_mut(block)
+            .zip(b.par_chunks_mut(block))
+            .zip(c.par_chunks_mut(block))
+            .enumerate()
+            .for_each(|(k, ((a, b), c))| f(k * block, a, b, c));
+    }
+}
+
 /// Particles per block when scanning for the first bad particle.
 const SCAN_BLOCK: usize = 1 << 14;
 
@@ -72,16 +92,26 @@ pub(crate) fn all_sane(x: &[Vec3], v: &[Vec3], bound: f64) -> bool {
 /// Elements per block of the vector helpers below.
 const VECTOR_BLOCK: usize = 1 << 12;
 
-/// `out[i] = f(i, &mut out[i])` for every particle, in parallel blocks for large systems.
+/// `f(i, &mut out[i])` for every particle, in parallel blocks of [`VECTOR_BLOCK`].
 pub(crate) fn for_each(out: &mut [Vec3], f: impl Fn(usize, &mut Vec3) + Sync + Send) {
-    if out.len() <= VECTOR_BLOCK {
+    for_each_in(VECTOR_BLOCK, out, f);
+}
+
+/// `f(i, &mut out[i])` for every particle, in parallel blocks of `block` (inline when there
+/// is only one).
+pub(crate) fn for_each_in(
+    block: usize,
+    out: &mut [Vec3],
+    f: impl Fn(usize, &mut Vec3) + Sync + Send,
+) {
+    if out.len() <= block {
         out.iter_mut().enumerate().for_each(|(i, o)| f(i, o));
     } else {
-        out.par_chunks_mut(VECTOR_BLOCK)
+        out.par_chunks_mut(block)
             .enumerate()
             .for_each(|(b, chunk)| {
                 for (k, o) in chunk.iter_mut().enumerate() {
-                    f(b * VECTOR_BLOCK + k, o);
+                    f(b * block + k, o);
                 }
             });
     }

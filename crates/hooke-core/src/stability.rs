@@ -8,6 +8,7 @@
 
 use crate::integrator::Integrator;
 use crate::model::Model;
+use crate::parallel;
 use crate::particles::{Particles, Vec3};
 use crate::response::Response;
 
@@ -53,11 +54,11 @@ impl StabilityEstimate {
         for _ in 0..POWER_ITERATIONS {
             normalise(&mut u);
             apply(model, particles, penalty_k, &u, &mut w);
-            lambda = dot(&u, &w);
+            lambda = parallel::dot(&u, &w);
             std::mem::swap(&mut u, &mut w);
         }
         // The Rayleigh quotient converges from below; the last growth factor bounds the error.
-        let growth = dot(&u, &u).sqrt();
+        let growth = parallel::dot(&u, &u).sqrt();
         Self {
             omega_max: lambda.max(growth).max(0.0).sqrt(),
         }
@@ -104,12 +105,8 @@ fn apply(model: &Model, p: &Particles, penalty_k: f64, u: &[Vec3], out: &mut [Ve
     }
 }
 
-fn dot(a: &[Vec3], b: &[Vec3]) -> f64 {
-    a.iter().zip(b).map(|(a, b)| a.dot(b)).sum()
-}
-
 fn normalise(u: &mut [Vec3]) {
-    let norm = dot(u, u).sqrt();
+    let norm = parallel::dot(u, u).sqrt();
     if norm > 0.0 {
         for x in u.iter_mut() {
             *x /= norm;

@@ -78,7 +78,7 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
             *b = if fixed(i) {
                 Vec3::zeros()
             } else {
-                (f0[i] - asm.spring_force(i) * dt) * dt
+                (f0[i] - asm.gathered(i) * dt) * dt
             }
         });
     }
@@ -113,7 +113,7 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
             *t = if fixed(i) {
                 Vec3::zeros()
             } else {
-                from[i] * (mass[i] + diagonal_shift) + asm.spring_force(i)
+                from[i] * (mass[i] + diagonal_shift) + asm.gathered(i)
             }
         });
     };

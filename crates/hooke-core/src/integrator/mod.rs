@@ -119,7 +119,6 @@ pub struct Workspace {
     pub(crate) assembly: Assembly,
     /// Positions at the start of the current step.
     pub(crate) x0: Vec<Vec3>,
-    pub(crate) v0: Vec<Vec3>,
     /// Stage derivatives: `kx` are velocities, `kv` accelerations.
     pub(crate) kx: [Vec<Vec3>; 4],
     pub(crate) kv: [Vec<Vec3>; 4],
@@ -145,7 +144,7 @@ impl Workspace {
         }
         let zero = Vec3::zeros();
         self.stuck.resize(particles, false);
-        for buf in [&mut self.x0, &mut self.v0, &mut self.xt, &mut self.vt]
+        for buf in [&mut self.x0, &mut self.xt, &mut self.vt]
             .into_iter()
             .chain(self.kx.iter_mut())
             .chain(self.kv.iter_mut())

@@ -6,14 +6,14 @@
 use super::Workspace;
 use crate::assembly::BLOCK;
 use crate::model::Model;
+use crate::parallel;
 use crate::particles::Particles;
-use rayon::prelude::*;
 
 pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) {
     ws.assembly.scatter(&p.x, &p.v);
     let asm = &ws.assembly;
     let (mass, inv_mass) = (&p.mass, &p.inv_mass);
-    let update = |start: usize, (x, v, x0): (&mut [_], &mut [_], &mut [_])| {
+    parallel::for_blocks3(BLOCK, &mut p.x, &mut p.v, &mut ws.x0, |start, x, v, x0| {
         for k in 0..x.len() {
             let i = start + k;
             x0[k] = x[k];
@@ -24,14 +24,5 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
             v[k] += f * inv_mass[i] * dt;
             x[k] += v[k] * dt;
         }
-    };
-    if p.len() <= BLOCK {
-        update(0, (&mut p.x, &mut p.v, &mut ws.x0));
-    } else {
-        p.x.par_chunks_mut(BLOCK)
-            .zip(p.v.par_chunks_mut(BLOCK))
-            .zip(ws.x0.par_chunks_mut(BLOCK))
-            .enumerate()
-            .for_each(|(b, ((x, v), x0))| update(b * BLOCK, (x, v, x0)));
-    }
+    });
 }
