@@ -2,7 +2,7 @@
 //! the problem, contacts are resolved per particle, pixels are written once per tile.
 
 use crate::common::{builtin, with_integrator};
-use hooke_core::{Integrator, Vec3};
+use hooke_core::{Integrator, Kernel, Vec3};
 use hooke_scene::{Overrides, Scene};
 
 fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
@@ -55,4 +55,25 @@ fn cloth_table_contacts_are_bit_identical_on_one_and_two_threads() {
         })
     };
     assert_eq!(run(1), run(2));
+}
+
+/// The force loop's compilations for wider vector units (AVX2, AVX-512) give the portable
+/// build's bits: on the cloth workload and on the cloth-table scene, whose springs have
+/// several stiffnesses. Only the kernels this CPU runs are compared.
+#[test]
+fn every_force_kernel_gives_the_same_trajectory() {
+    let run = |kernel: Kernel| {
+        let spec = with_integrator(hooke_scene::workload::cloth(100), Integrator::Rk4);
+        let mut cloth = spec.build(std::path::Path::new(".")).unwrap();
+        cloth.simulation.set_kernel(kernel).unwrap();
+        cloth.simulation.advance(50).unwrap();
+        let mut table = builtin("cloth-table", &Overrides::default());
+        table.simulation.set_kernel(kernel).unwrap();
+        table.simulation.advance(1000).unwrap();
+        (state(&cloth), state(&table))
+    };
+    let portable = run(Kernel::Portable);
+    for kernel in Kernel::available() {
+        assert!(run(kernel) == portable, "{kernel} differs from portable");
+    }
 }

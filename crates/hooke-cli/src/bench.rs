@@ -6,7 +6,7 @@
 use crate::draw::{Style, draw, frame_camera};
 use crate::source;
 use anyhow::{Context, Result, bail};
-use hooke_core::Integrator;
+use hooke_core::{Integrator, Kernel, Simulation};
 use hooke_render::{RenderOptions, Renderer};
 use hooke_scene::workload;
 use hooke_scene::{Overrides, Scene};
@@ -34,6 +34,9 @@ pub enum Bench {
         /// Integrator.
         #[arg(long, default_value_t = Integrator::Symplectic)]
         integrator: Integrator,
+        /// Force-loop compilation (default: the widest this CPU runs).
+        #[arg(long)]
+        kernel: Option<Kernel>,
         /// Print one JSON object instead of text.
         #[arg(long)]
         json: bool,
@@ -51,6 +54,9 @@ pub enum Bench {
         /// Step size in seconds (default: the scene's).
         #[arg(long)]
         dt: Option<f64>,
+        /// Force-loop compilation (default: the widest this CPU runs).
+        #[arg(long)]
+        kernel: Option<Kernel>,
         /// Worker threads (default: one per core).
         #[arg(long)]
         threads: Option<usize>,
@@ -91,6 +97,7 @@ struct ClothFigures {
     steps: u64,
     threads: usize,
     integrator: String,
+    kernel: String,
     springs: usize,
     seconds: f64,
     steps_per_s: f64,
@@ -105,6 +112,7 @@ struct SceneFigures {
     /// Average conjugate-gradient iterations per step (implicit only).
     cg_iterations_per_step: f64,
     integrator: String,
+    kernel: String,
     particles: usize,
     springs: usize,
     steps: u64,
@@ -160,13 +168,15 @@ pub fn run(bench: &Bench) -> Result<ExitCode> {
             steps,
             threads,
             integrator,
+            kernel,
             json,
-        } => pool(*threads)?.install(|| cloth(*n, *steps, *integrator, *json)),
+        } => pool(*threads)?.install(|| cloth(*n, *steps, *integrator, *kernel, *json)),
         Bench::Scene {
             scene,
             steps,
             integrator,
             dt,
+            kernel,
             threads,
             json,
         } => {
@@ -175,7 +185,7 @@ pub fn run(bench: &Bench) -> Result<ExitCode> {
                 dt: *dt,
                 ..Overrides::default()
             };
-            pool(*threads)?.install(|| scene_steps(scene, &overrides, *steps, *json))
+            pool(*threads)?.install(|| scene_steps(scene, &overrides, *kernel, *steps, *json))
         }
         Bench::Render {
             targets,
@@ -198,12 +208,29 @@ pub fn run(bench: &Bench) -> Result<ExitCode> {
     }
 }
 
-fn cloth(n: usize, steps: u64, integrator: Integrator, json: bool) -> Result<ExitCode> {
+/// Sets the force loop's compilation, if one was asked for.
+fn use_kernel(sim: &mut Simulation, kernel: Option<Kernel>) -> Result<()> {
+    if let Some(kernel) = kernel {
+        sim.set_kernel(kernel)
+            .map_err(|best| anyhow::anyhow!("--kernel {kernel}: this CPU runs at most {best}"))?;
+    }
+    Ok(())
+}
+
+fn cloth(
+    n: usize,
+    steps: u64,
+    integrator: Integrator,
+    kernel: Option<Kernel>,
+    json: bool,
+) -> Result<ExitCode> {
     // Warm-up on a separate copy: page in the buffers and start the workers, so the measured
     // run starts from the workload's initial state.
     let mut warm = workload(n, steps, integrator)?;
+    use_kernel(&mut warm.simulation, kernel)?;
     warm.simulation.advance(steps.min(20))?;
     let mut scene = workload(n, steps, integrator)?;
+    use_kernel(&mut scene.simulation, kernel)?;
     let started = Instant::now();
     scene.simulation.advance(steps)?;
     let seconds = started.elapsed().as_secs_f64();
@@ -213,6 +240,7 @@ fn cloth(n: usize, steps: u64, integrator: Integrator, json: bool) -> Result<Exi
         steps,
         threads: rayon::current_num_threads(),
         integrator: integrator.to_string(),
+        kernel: scene.simulation.workspace().kernel().to_string(),
         springs,
         seconds,
         steps_per_s: steps as f64 / seconds,
@@ -223,9 +251,10 @@ fn cloth(n: usize, steps: u64, integrator: Integrator, json: bool) -> Result<Exi
         println!("{}", serde_json::to_string(&figures)?);
     } else {
         println!(
-            "cloth N={n}: {springs} springs, {steps} {integrator} steps on {} threads in {:.3} s: \
-             {:.1} steps/s, {:.1} M spring updates/s; centre y = {:.12}",
+            "cloth N={n}: {springs} springs, {steps} {integrator} steps on {} threads ({} \
+             kernel) in {:.3} s: {:.1} steps/s, {:.1} M spring updates/s; centre y = {:.12}",
             figures.threads,
+            figures.kernel,
             seconds,
             figures.steps_per_s,
             figures.spring_updates_per_s / 1e6,
@@ -235,12 +264,19 @@ fn cloth(n: usize, steps: u64, integrator: Integrator, json: bool) -> Result<Exi
     Ok(ExitCode::SUCCESS)
 }
 
-fn scene_steps(name: &str, overrides: &Overrides, steps: u64, json: bool) -> Result<ExitCode> {
+fn scene_steps(
+    name: &str,
+    overrides: &Overrides,
+    kernel: Option<Kernel>,
+    steps: u64,
+    json: bool,
+) -> Result<ExitCode> {
     if steps == 0 {
         bail!("--steps: expected at least 1");
     }
     let mut scene = source::build(name, overrides)?;
     let sim = &mut scene.simulation;
+    use_kernel(sim, kernel)?;
     sim.advance(steps.min(100))?;
     let started = Instant::now();
     let mut cg_iterations = 0;
@@ -254,6 +290,7 @@ fn scene_steps(name: &str, overrides: &Overrides, steps: u64, json: bool) -> Res
         dt: sim.dt(),
         scene: scene.spec.name.clone(),
         integrator: sim.integrator().to_string(),
+        kernel: sim.workspace().kernel().to_string(),
         particles: sim.particles().len(),
         springs: sim.model().springs.len(),
         steps,
@@ -265,14 +302,15 @@ fn scene_steps(name: &str, overrides: &Overrides, steps: u64, json: bool) -> Res
         println!("{}", serde_json::to_string(&figures)?);
     } else {
         println!(
-            "{}: {} particles, {} springs, {steps} {} steps of {} s on {} threads in {:.3} s: \
-             {:.0} steps/s, {:.3} s per simulated second{}",
+            "{}: {} particles, {} springs, {steps} {} steps of {} s on {} threads ({} kernel) \
+             in {:.3} s: {:.0} steps/s, {:.3} s per simulated second{}",
             figures.scene,
             figures.particles,
             figures.springs,
             figures.integrator,
             figures.dt,
             figures.threads,
+            figures.kernel,
             seconds,
             figures.steps_per_s,
             seconds / (steps as f64 * figures.dt),

@@ -2,6 +2,8 @@
 //! reading SCENE arguments, atomic output files and the demo's stills. The binary's
 //! commands are built on it, and the validation suite renders its golden images with it.
 
+#![forbid(unsafe_code)]
+
 pub mod draw;
 pub mod image_out;
 pub mod interrupt;

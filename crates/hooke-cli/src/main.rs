@@ -1,5 +1,7 @@
 //! `hooke`: run, render and inspect mass-spring scenes.
 
+#![forbid(unsafe_code)]
+
 mod bench;
 mod picture;
 mod run;

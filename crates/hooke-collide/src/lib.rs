@@ -24,6 +24,8 @@
 //! assert!(!table.inside(&Vec3::new(0.1, 1.01, 0.0)));  // just above it
 //! ```
 
+#![forbid(unsafe_code)]
+
 mod box_interior;
 mod cylinder;
 mod obj;

@@ -11,8 +11,8 @@
 //! buffers add little memory beyond one force per particle, and each partition reads
 //! positions from a small, cache-resident stretch of the arrays.
 
+use crate::kernel::Kernel;
 use crate::model::Model;
-use crate::parallel;
 use crate::particles::Vec3;
 use crate::spring::{Lanes, Spring, spring_lanes};
 use rayon::prelude::*;
@@ -31,11 +31,12 @@ fn partition_size(springs: usize) -> usize {
 
 /// Particles per reduction block: the gather adds external forces (a force field sample,
 /// collider queries), costly enough to share a 512-particle jelly in two.
-const REDUCE_BLOCK: usize = 256;
+pub const REDUCE_BLOCK: usize = 256;
 
 /// Particles per block of the integrators' cheap per-particle updates: below this a
 /// system is updated inline, as a rayon call would cost more than the work.
 pub const BLOCK: usize = 1 << 12;
+const _: () = assert!(BLOCK.is_multiple_of(REDUCE_BLOCK));
 
 /// The springs of a model in the solver's layout: end pairs, rest lengths and an index into
 /// a table of distinct `(ks, kd)` pairs, one array each, so the hot loop streams 20 bytes per
@@ -116,35 +117,7 @@ impl Sym3 {
     }
 }
 
-/// Springs computed side by side in the force loop.
-const LANES: usize = 2;
-
 impl SpringTable {
-    /// The forces of springs `k..k + L` on their lower ends.
-    #[inline(always)]
-    fn lanes<const L: usize>(&self, k: usize, x: &[Vec3], v: &[Vec3]) -> [[f64; 3]; L] {
-        let mut s = Lanes {
-            d: [[0.0; L]; 3],
-            dv: [[0.0; L]; 3],
-            rest: [0.0; L],
-            ks: [0.0; L],
-            kd: [0.0; L],
-        };
-        for l in 0..L {
-            let [i, j] = self.ends[k + l];
-            let (i, j) = (i as usize, j as usize);
-            let (d, dv) = (x[i] - x[j], v[i] - v[j]);
-            for c in 0..3 {
-                s.d[c][l] = d[c];
-                s.dv[c][l] = dv[c];
-            }
-            s.rest[l] = self.rest[k + l];
-            [s.ks[l], s.kd[l]] = self.params(k + l);
-        }
-        let f = spring_lanes(&s);
-        std::array::from_fn(|l| [f[0][l], f[1][l], f[2][l]])
-    }
-
     #[inline]
     fn params(&self, k: usize) -> [f64; 2] {
         if self.param.is_empty() {
@@ -154,6 +127,75 @@ impl SpringTable {
         }
     }
 }
+
+/// Springs per batch of the force loop.
+const LANES: usize = 64;
+
+/// Adds the forces of the springs `ends`/`rest` into `force`, the window of particles from
+/// `lo`. With `UNIFORM`, every spring has stiffness and damping `params[0]`; otherwise
+/// spring `k` has `params[param[k]]`.
+///
+/// Springs go in batches of [`LANES`], in three passes: load each spring's end
+/// differences into component arrays, compute the batch's forces in one vectorised loop
+/// ([`spring_lanes`]), then add them to the ends. The middle pass is where the arithmetic
+/// is, and only there can the compiler run several springs per instruction; the outer
+/// passes move data between the particles' layout and the batch's.
+#[inline(always)]
+pub(crate) fn scatter_springs<const UNIFORM: bool>(
+    (ends, rest): (&[[u32; 2]], &[f64]),
+    (param, params): (&[u32], &[[f64; 2]]),
+    (lo, force): (usize, &mut [Vec3]),
+    x: &[Vec3],
+    v: &[Vec3],
+) {
+    // Equal lengths let one bounds check on `x` cover `v` too.
+    let v = &v[..x.len()];
+    let mut lanes = Lanes::<LANES>::default();
+    if UNIFORM {
+        let [ks, kd] = params[0];
+        lanes.ks = [ks; LANES];
+        lanes.kd = [kd; LANES];
+    }
+    let mut f = [[0.0; LANES]; 3];
+    // Springs sharing a lower end are consecutive: sum their pull on it in a register and
+    // store once, instead of a store-to-load chain through memory per spring.
+    let mut current = lo;
+    let mut pull = Vec3::zeros();
+    for (b, (ends, rest)) in ends.chunks(LANES).zip(rest.chunks(LANES)).enumerate() {
+        let n = ends.len().min(rest.len()).min(LANES);
+        for l in 0..n {
+            let [i, j] = ends[l];
+            let (i, j) = (i as usize, j as usize);
+            lanes.set(l, (&(x[i] - x[j]), &(v[i] - v[j])), rest[l]);
+            if !UNIFORM {
+                [lanes.ks[l], lanes.kd[l]] = params[param[b * LANES + l] as usize];
+            }
+        }
+        spring_lanes(&lanes, n, &mut f);
+        for l in 0..n {
+            let [i, j] = ends[l];
+            let (i, j) = (i as usize, j as usize);
+            let f = Vec3::new(f[0][l], f[1][l], f[2][l]);
+            if i != current {
+                force[current - lo] += pull;
+                pull = Vec3::zeros();
+                current = i;
+            }
+            pull += f;
+            force[j - lo] -= f;
+        }
+    }
+    force[current - lo] += pull;
+}
+
+/// The arguments of [`scatter_springs`].
+pub(crate) type ScatterArgs<'a> = (
+    (&'a [[u32; 2]], &'a [f64]),
+    (&'a [u32], &'a [[f64; 2]]),
+    (usize, &'a mut [Vec3]),
+    &'a [Vec3],
+    &'a [Vec3],
+);
 
 #[derive(Clone, Debug)]
 struct Partition {
@@ -185,6 +227,7 @@ pub struct Assembly {
     block_start: Vec<u32>,
     block_parts: Vec<u32>,
     particles: usize,
+    kernel: Kernel,
 }
 
 impl Assembly {
@@ -257,6 +300,20 @@ impl Assembly {
             block_start,
             block_parts,
             particles,
+            kernel: Kernel::detect(),
+        }
+    }
+
+    /// The compilation of the force loop in use: [`Kernel::detect`]'s unless set.
+    pub fn kernel(&self) -> Kernel {
+        self.kernel
+    }
+
+    /// Runs the force loop compiled for `kernel`, which must be one of
+    /// [`Kernel::available`] (otherwise the detected one stays in use).
+    pub fn set_kernel(&mut self, kernel: Kernel) {
+        if kernel <= Kernel::detect() {
+            self.kernel = kernel;
         }
     }
 
@@ -267,40 +324,18 @@ impl Assembly {
 
     /// Computes every spring's force at `(x, v)` into the partition buffers.
     pub fn scatter(&mut self, x: &[Vec3], v: &[Vec3]) {
-        let table = &self.table;
+        let (table, kernel) = (&self.table, self.kernel);
         let scatter = |part: &mut Partition| {
             part.force.fill(Vec3::zeros());
-            let lo = part.lo;
-            // Springs sharing a lower end are consecutive: sum their pull on it in a register
-            // and store once, instead of a store-to-load chain through memory per spring.
-            let mut current = part.lo;
-            let mut pull = Vec3::zeros();
-            let mut add = |k: usize, f: [f64; 3]| {
-                let [i, j] = table.ends[k];
-                let (i, j) = (i as usize, j as usize);
-                if i != current {
-                    part.force[current - lo] += pull;
-                    pull = Vec3::zeros();
-                    current = i;
-                }
-                let f = Vec3::new(f[0], f[1], f[2]);
-                pull += f;
-                part.force[j - lo] -= f;
-            };
-            // Springs in batches of LANES, computed side by side so the compiler can use
-            // vector instructions and overlap their square roots and divisions.
-            let springs = part.springs.clone();
-            let mut k = springs.start;
-            while k + LANES <= springs.end {
-                for (l, f) in table.lanes::<LANES>(k, x, v).into_iter().enumerate() {
-                    add(k + l, f);
-                }
-                k += LANES;
+            let r = part.springs.clone();
+            let springs = (&table.ends[r.clone()], &table.rest[r.clone()]);
+            let window = (part.lo, &mut part.force[..]);
+            if table.param.is_empty() {
+                kernel.scatter::<true>((springs, (&[], &table.params), window, x, v));
+            } else {
+                let params = (&table.param[r], &table.params[..]);
+                kernel.scatter::<false>((springs, params, window, x, v));
             }
-            for k in k..springs.end {
-                add(k, table.lanes::<1>(k, x, v)[0]);
-            }
-            part.force[current - lo] += pull;
         };
         each_partition(&mut self.partitions, scatter);
     }
@@ -382,15 +417,66 @@ impl Assembly {
         f
     }
 
-    /// The total force on particle `p`: external forces, attachments and springs (after a
-    /// scatter at the same `(x, v)`).
+    /// The spring sums of the last scatter (see [`Assembly::gathered`]) for particles
+    /// `start..start + out.len()`, a block that starts on a multiple of [`REDUCE_BLOCK`] and
+    /// spans at most one. Adds each window's overlap with the block as one slice, so the
+    /// per-particle loops that follow do no window lookups; the sums are the same bits as
+    /// [`Assembly::gathered`].
+    pub fn gather_block(&self, start: usize, out: &mut [Vec3]) {
+        debug_assert!(start.is_multiple_of(REDUCE_BLOCK) && out.len() <= REDUCE_BLOCK);
+        out.fill(Vec3::zeros());
+        let b = start / REDUCE_BLOCK;
+        let end = start + out.len();
+        let parts =
+            &self.block_parts[self.block_start[b] as usize..self.block_start[b + 1] as usize];
+        for &q in parts {
+            let part = &self.partitions[q as usize];
+            let (lo, hi) = (part.lo.max(start), (part.lo + part.force.len()).min(end));
+            if lo < hi {
+                let window = &part.force[lo - part.lo..hi - part.lo];
+                for (o, f) in out[lo - start..hi - start].iter_mut().zip(window) {
+                    *o += f;
+                }
+            }
+        }
+    }
+
+    /// The total force on particle `p` at `(x, v)` given `springs`, its spring sum: external
+    /// forces, attachments and springs.
     #[inline]
-    pub fn force(&self, model: &Model, mass: f64, x: &Vec3, v: &Vec3, p: usize) -> Vec3 {
-        let f = model.external_force(mass, x, v) + self.gathered(p);
+    pub fn force(model: &Model, mass: f64, x: &Vec3, v: &Vec3, p: usize, springs: Vec3) -> Vec3 {
+        let f = model.external_force(mass, x, v) + springs;
         if model.attachments.is_empty() {
             f
         } else {
             f + model.attachment_force(p, x, v)
+        }
+    }
+
+    /// Scatters at `(x, v)`, then sets `out[p] = map(p, F_p)` for every particle, `F_p` its
+    /// total force, in parallel blocks.
+    pub fn forces(
+        &mut self,
+        model: &Model,
+        mass: &[f64],
+        (x, v): (&[Vec3], &[Vec3]),
+        out: &mut [Vec3],
+        map: impl Fn(usize, Vec3) -> Vec3 + Sync + Send,
+    ) {
+        self.scatter(x, v);
+        let block = |start: usize, out: &mut [Vec3]| {
+            self.gather_block(start, out);
+            for (k, o) in out.iter_mut().enumerate() {
+                let p = start + k;
+                *o = map(p, Self::force(model, mass[p], &x[p], &v[p], p, *o));
+            }
+        };
+        if out.len() <= REDUCE_BLOCK {
+            block(0, out);
+        } else {
+            out.par_chunks_mut(REDUCE_BLOCK)
+                .enumerate()
+                .for_each(|(b, chunk)| block(b * REDUCE_BLOCK, chunk));
         }
     }
 
@@ -403,13 +489,12 @@ impl Assembly {
         v: &[Vec3],
         a: &mut [Vec3],
     ) {
-        self.scatter(x, v);
-        parallel::for_each_in(REDUCE_BLOCK, a, |p, out| {
-            *out = if inv_mass[p] == 0.0 {
+        self.forces(model, mass, (x, v), a, |p, f| {
+            if inv_mass[p] == 0.0 {
                 Vec3::zeros()
             } else {
-                self.force(model, mass[p], &x[p], &v[p], p) * inv_mass[p]
-            };
+                f * inv_mass[p]
+            }
         });
     }
 }

@@ -1,6 +1,7 @@
 //! A running system: particles, model, integrator and step size, stepped with divergence checks.
 
 use crate::integrator::{Integrator, Workspace};
+use crate::kernel::Kernel;
 use crate::model::{Attachment, Model};
 use crate::parallel;
 use crate::particles::{Particles, Vec3};
@@ -87,6 +88,17 @@ impl Simulation {
     /// a mouse grab; takes effect from the next step.
     pub fn set_attachments(&mut self, attachments: Vec<Attachment>) {
         self.model.attachments = attachments;
+    }
+
+    /// Runs the force loop compiled for `kernel` (see [`Kernel`]); the widest available is
+    /// the default. A kernel the CPU lacks is refused with the best it has.
+    pub fn set_kernel(&mut self, kernel: Kernel) -> Result<(), Kernel> {
+        if kernel <= Kernel::detect() {
+            self.workspace.kernel = Some(kernel);
+            Ok(())
+        } else {
+            Err(Kernel::detect())
+        }
     }
 
     /// The integrators' buffers (for figures such as [`Workspace::cg_iterations`]).

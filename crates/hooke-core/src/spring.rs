@@ -78,13 +78,12 @@ impl Spring {
 /// force path goes through [`spring_lanes`], so they agree to the bit.
 #[inline]
 pub(crate) fn spring_force(d: Vec3, dv: Vec3, rest: f64, ks: f64, kd: f64) -> Vec3 {
-    let f = spring_lanes(&Lanes {
-        d: [[d.x], [d.y], [d.z]],
-        dv: [[dv.x], [dv.y], [dv.z]],
-        rest: [rest],
-        ks: [ks],
-        kd: [kd],
-    });
+    let mut s = Lanes::<1>::default();
+    s.set(0, (&d, &dv), rest);
+    s.ks = [ks];
+    s.kd = [kd];
+    let mut f = [[0.0]; 3];
+    spring_lanes(&s, 1, &mut f);
     Vec3::new(f[0][0], f[1][0], f[2][0])
 }
 
@@ -98,36 +97,52 @@ pub(crate) struct Lanes<const L: usize> {
     pub kd: [f64; L],
 }
 
-/// [`spring_force`] for `L` springs side by side, component arrays in and out, without
-/// branches: each step is a loop over lanes that compiles to vector instructions, and the
-/// square roots and divisions of different springs overlap.
+impl<const L: usize> Default for Lanes<L> {
+    fn default() -> Self {
+        Self {
+            d: [[0.0; L]; 3],
+            dv: [[0.0; L]; 3],
+            rest: [0.0; L],
+            ks: [0.0; L],
+            kd: [0.0; L],
+        }
+    }
+}
+
+impl<const L: usize> Lanes<L> {
+    /// Sets lane `l`'s end differences and rest length.
+    #[inline(always)]
+    pub fn set(&mut self, l: usize, (d, dv): (&Vec3, &Vec3), rest: f64) {
+        for c in 0..3 {
+            self.d[c][l] = d[c];
+            self.dv[c][l] = dv[c];
+        }
+        self.rest[l] = rest;
+    }
+}
+
+/// [`spring_force`] for the first `n` of `L` springs side by side, component arrays in and
+/// out. The loop body has no branch (the degenerate case is a select after the division),
+/// so the compiler vectorises it at the target's full width: square roots and divisions,
+/// the bottleneck of a spring, then run several springs per instruction.
 #[inline(always)]
-pub(crate) fn spring_lanes<const L: usize>(s: &Lanes<L>) -> [[f64; L]; 3] {
+pub(crate) fn spring_lanes<const L: usize>(s: &Lanes<L>, n: usize, f: &mut [[f64; L]; 3]) {
     let [dx, dy, dz] = &s.d;
     let [vx, vy, vz] = &s.dv;
-    let len: [f64; L] =
-        std::array::from_fn(|l| (dx[l] * dx[l] + dy[l] * dy[l] + dz[l] * dz[l]).sqrt());
-    // One division instead of three: the reciprocal scales all components.
-    // A degenerate spring gets a zero direction, hence zero force, never 0·∞ = NaN.
-    let inv: [f64; L] = std::array::from_fn(|l| {
-        if len[l] < DEGENERATE_LENGTH {
+    let [fx, fy, fz] = f;
+    for l in 0..n.min(L) {
+        let len = (dx[l] * dx[l] + dy[l] * dy[l] + dz[l] * dz[l]).sqrt();
+        // One division instead of three: the reciprocal scales all components. A degenerate
+        // spring gets a zero direction, hence zero force, never 0·∞ = NaN.
+        let inv = if len < DEGENERATE_LENGTH {
             0.0
         } else {
-            1.0 / len[l]
-        }
-    });
-    let u: [[f64; L]; 3] = [
-        std::array::from_fn(|l| dx[l] * inv[l]),
-        std::array::from_fn(|l| dy[l] * inv[l]),
-        std::array::from_fn(|l| dz[l] * inv[l]),
-    ];
-    let scale: [f64; L] = std::array::from_fn(|l| {
-        -s.ks[l] * (len[l] - s.rest[l])
-            - s.kd[l] * (vx[l] * u[0][l] + vy[l] * u[1][l] + vz[l] * u[2][l])
-    });
-    [
-        std::array::from_fn(|l| u[0][l] * scale[l]),
-        std::array::from_fn(|l| u[1][l] * scale[l]),
-        std::array::from_fn(|l| u[2][l] * scale[l]),
-    ]
+            1.0 / len
+        };
+        let (ux, uy, uz) = (dx[l] * inv, dy[l] * inv, dz[l] * inv);
+        let scale = -s.ks[l] * (len - s.rest[l]) - s.kd[l] * (vx[l] * ux + vy[l] * uy + vz[l] * uz);
+        fx[l] = ux * scale;
+        fy[l] = uy * scale;
+        fz[l] = uz * scale;
+    }
 }

@@ -18,6 +18,8 @@
 //! assert!(centre[0] > centre[1] + 50, "the red triangle covers the centre: {centre:?}");
 //! ```
 
+#![forbid(unsafe_code)]
+
 mod bins;
 mod camera;
 mod draw_list;

@@ -16,6 +16,8 @@
 //! scene.simulation.advance(10).unwrap();
 //! ```
 
+#![forbid(unsafe_code)]
+
 mod build;
 pub mod builtin;
 pub mod generators;

@@ -49,12 +49,7 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
 
     // Forces at the current state.
     let [f0, b, dv, r] = &mut ws.kv;
-    asm.scatter(&p.x, &p.v);
-    {
-        let asm = &*asm;
-        let (x, v, mass) = (&p.x, &p.v, &p.mass);
-        parallel::for_each(f0, |i, f| *f = asm.force(model, mass[i], &x[i], &v[i], i));
-    }
+    asm.forces(model, &p.mass, (&p.x, &p.v), f0, |_, f| f);
 
     // Jacobian blocks and the system's per-spring blocks.
     asm.spring_blocks(&p.x, &mut buffers.blocks);

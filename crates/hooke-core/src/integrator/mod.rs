@@ -11,6 +11,7 @@ mod rk4;
 mod symplectic;
 
 use crate::assembly::{Assembly, BLOCK};
+use crate::kernel::Kernel;
 use crate::model::Model;
 use crate::parallel;
 use crate::particles::{Particles, Vec3};
@@ -129,6 +130,8 @@ pub struct Workspace {
     pub(crate) implicit: implicit::ImplicitBuffers,
     /// Particles held by a stick response (see [`Model::resolve_contacts`]).
     pub(crate) stuck: Vec<bool>,
+    /// The force loop's compilation, when not the detected one.
+    pub(crate) kernel: Option<Kernel>,
 }
 
 impl Workspace {
@@ -142,6 +145,9 @@ impl Workspace {
         if !self.assembly.fits(particles, springs) {
             self.assembly = Assembly::new(particles, &model.springs);
         }
+        if let Some(kernel) = self.kernel {
+            self.assembly.set_kernel(kernel);
+        }
         let zero = Vec3::zeros();
         self.stuck.resize(particles, false);
         for buf in [&mut self.x0, &mut self.xt, &mut self.vt]
@@ -151,6 +157,11 @@ impl Workspace {
         {
             buf.resize(particles, zero);
         }
+    }
+
+    /// The compilation of the force loop in use.
+    pub fn kernel(&self) -> Kernel {
+        self.kernel.unwrap_or_else(Kernel::detect)
     }
 
     /// Positions at the start of the last step.

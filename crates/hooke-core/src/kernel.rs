@@ -1,0 +1,255 @@
+//! The force loop's compilations for the instruction sets of the CPU it runs on.
+//!
+//! The spring forces are the solver's hot loop, and their cost is a square root and a
+//! division per spring, whose throughput per instruction is the same for 1, 2, 4 or 8
+//! lanes on current x86 cores: wider vectors are nearly free speed. Portable builds target
+//! baseline x86-64 (2 lanes), so the loop is compiled again for AVX2 and AVX-512 and the
+//! widest the CPU supports is picked at run time. This is the workspace's one use of
+//! `unsafe`: calling a function compiled for features that were checked to be present.
+
+use crate::assembly::{ScatterArgs, scatter_springs};
+use crate::particles::Vec3;
+use std::fmt;
+use std::str::FromStr;
+
+/// Which compilation of the force loop runs. The same code is compiled for each
+/// instruction set, and without fused multiply-adds (Rust never contracts `a * b + c`),
+/// each lane does the same correctly rounded operations in the same order: every kernel
+/// gives the same bits, as a test checks. Wider vectors pay where a spring's cost is, its
+/// square root and division, whose throughput per instruction does not depend on the
+/// width on current x86 cores.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Kernel {
+    /// Baseline x86-64 (SSE2), or whatever the target compiles for elsewhere.
+    #[default]
+    Portable,
+    /// AVX2: four springs per instruction.
+    Avx2,
+    /// AVX-512: eight springs per instruction.
+    Avx512,
+}
+
+impl Kernel {
+    /// The widest kernel this CPU runs.
+    pub fn detect() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx512f")
+                && std::arch::is_x86_feature_detected!("avx512vl")
+            {
+                return Self::Avx512;
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                return Self::Avx2;
+            }
+        }
+        Self::Portable
+    }
+
+    /// Every kernel this CPU runs, narrowest first.
+    pub fn available() -> Vec<Self> {
+        Self::ALL
+            .into_iter()
+            .filter(|k| *k <= Self::detect())
+            .collect()
+    }
+
+    /// Every kernel, narrowest first.
+    pub const ALL: [Kernel; 3] = [Self::Portable, Self::Avx2, Self::Avx512];
+
+    /// The lowercase name shown by benchmarks.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Portable => "portable",
+            Self::Avx2 => "avx2",
+            Self::Avx512 => "avx512",
+        }
+    }
+
+    /// Runs the spring force loop compiled for this kernel.
+    #[allow(unsafe_code)]
+    pub(crate) fn scatter<const UNIFORM: bool>(self, (springs, params, window, x, v): ScatterArgs) {
+        match self {
+            Self::Portable => scatter_springs::<UNIFORM>(springs, params, window, x, v),
+            // SAFETY: a kernel other than `Portable` comes from `detect`, which checked that
+            // the CPU has the features these functions are compiled for.
+            #[cfg(target_arch = "x86_64")]
+            Self::Avx2 => unsafe { scatter_avx2::<UNIFORM>(springs, params, window, x, v) },
+            #[cfg(target_arch = "x86_64")]
+            Self::Avx512 => unsafe { scatter_avx512::<UNIFORM>(springs, params, window, x, v) },
+            #[cfg(not(target_arch = "x86_64"))]
+            _ => scatter_springs::<UNIFORM>(springs, params, window, x, v),
+        }
+    }
+}
+
+impl fmt::Display for Kernel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The error for a kernel name that is not one of [`Kernel::ALL`].
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown kernel '{0}': expected one of portable, avx2, avx512")]
+pub struct UnknownKernel(pub String);
+
+impl FromStr for Kernel {
+    type Err = UnknownKernel;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| UnknownKernel(s.to_string()))
+    }
+}
+
+impl PartialOrd for Kernel {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Kernel {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        (*self as u8).cmp(&(*other as u8))
+    }
+}
+
+/// The spring force loop compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn scatter_avx2<const UNIFORM: bool>(
+    springs: (&[[u32; 2]], &[f64]),
+    params: (&[u32], &[[f64; 2]]),
+    window: (usize, &mut [Vec3]),
+    x: &[Vec3],
+    v: &[Vec3],
+) {
+    scatter_springs::<UNIFORM>(springs, params, window, x, v);
+}
+
+/// The spring force loop compiled for AVX-512.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+fn scatter_avx512<const UNIFORM: bool>(
+    springs: (&[[u32; 2]], &[f64]),
+    params: (&[u32], &[[f64; 2]]),
+    window: (usize, &mut [Vec3]),
+    x: &[Vec3],
+    v: &[Vec3],
+) {
+    scatter_springs::<UNIFORM>(springs, params, window, x, v);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assembly::Assembly;
+    use crate::spring::{Spring, SpringKind};
+
+    /// A deterministic jumble of particles and springs: random ends, lengths from 0 (a
+    /// degenerate spring) to far stretched, and several `(ks, kd)` pairs or just one.
+    fn jumble(uniform: bool) -> (Vec<Vec3>, Vec<Vec3>, Vec<Spring>) {
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let n = 3000;
+        let mut x: Vec<Vec3> = (0..n).map(|_| Vec3::new(next(), next(), next())).collect();
+        x[1] = x[0];
+        let v: Vec<Vec3> = (0..n)
+            .map(|_| Vec3::new(next(), next(), next()) * 0.1)
+            .collect();
+        let mut springs = vec![Spring {
+            i: 0,
+            j: 1,
+            rest: 0.5,
+            ks: 100.0,
+            kd: 0.5,
+            kind: SpringKind::Other,
+        }];
+        for k in 0..20_000 {
+            let i = (next() * n as f64) as u32;
+            // Mostly near neighbours, as in a mesh, sometimes anywhere.
+            let j = if k % 7 == 0 {
+                (next() * n as f64) as u32
+            } else {
+                (i + 1 + (next() * 40.0) as u32) % n as u32
+            };
+            if i == j {
+                continue;
+            }
+            let (ks, kd) = if uniform {
+                (100.0, 0.5)
+            } else {
+                (100.0 * (1 + k % 3) as f64, 0.25 * (k % 4) as f64)
+            };
+            springs.push(Spring {
+                i,
+                j,
+                rest: next() * 0.3,
+                ks,
+                kd,
+                kind: SpringKind::Other,
+            });
+        }
+        (x, v, springs)
+    }
+
+    #[test]
+    fn every_kernel_gives_the_same_bits() {
+        for uniform in [true, false] {
+            let (x, v, springs) = jumble(uniform);
+            let forces = |kernel: Kernel| {
+                let mut asm = Assembly::new(x.len(), &springs);
+                asm.set_kernel(kernel);
+                assert_eq!(asm.kernel(), kernel);
+                asm.scatter(&x, &v);
+                (0..x.len()).map(|p| asm.gathered(p)).collect::<Vec<_>>()
+            };
+            let portable = forces(Kernel::Portable);
+            // The layout sums the same forces as a naive loop over the springs, in another
+            // order: equal up to round-off.
+            let mut naive = vec![Vec3::zeros(); x.len()];
+            for s in &springs {
+                let (i, j) = (s.i as usize, s.j as usize);
+                let f = s.force(&x[i], &x[j], &v[i], &v[j]);
+                naive[i] += f;
+                naive[j] -= f;
+            }
+            for (p, (a, b)) in portable.iter().zip(&naive).enumerate() {
+                assert!(
+                    (a - b).norm() <= 1e-9 * (1.0 + b.norm()),
+                    "particle {p}: {a} vs {b}"
+                );
+            }
+            for kernel in Kernel::available() {
+                let f = forces(kernel);
+                let same = f.iter().zip(&portable).all(|(a, b)| {
+                    a.iter()
+                        .zip(b.iter())
+                        .all(|(a, b)| a.to_bits() == b.to_bits())
+                });
+                assert!(same, "{kernel} differs from portable (uniform: {uniform})");
+            }
+        }
+    }
+
+    #[test]
+    fn names_round_trip_and_unknown_names_are_refused() {
+        for kernel in Kernel::ALL {
+            assert_eq!(kernel.name().parse::<Kernel>(), Ok(kernel));
+        }
+        assert_eq!(
+            "sse9".parse::<Kernel>().unwrap_err().to_string(),
+            "unknown kernel 'sse9': expected one of portable, avx2, avx512"
+        );
+        assert!(Kernel::available().contains(&Kernel::Portable));
+        assert_eq!(Kernel::available().last(), Some(&Kernel::detect()));
+    }
+}
