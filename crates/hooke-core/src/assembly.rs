@@ -422,7 +422,7 @@ impl Assembly {
     /// spans at most one. Adds each window's overlap with the block as one slice, so the
     /// per-particle loops that follow do no window lookups; the sums are the same bits as
     /// [`Assembly::gathered`].
-    pub fn gather_block(&self, start: usize, out: &mut [Vec3]) {
+    pub(crate) fn gather_block(&self, start: usize, out: &mut [Vec3]) {
         debug_assert!(start.is_multiple_of(REDUCE_BLOCK) && out.len() <= REDUCE_BLOCK);
         out.fill(Vec3::zeros());
         let b = start / REDUCE_BLOCK;
