@@ -19,14 +19,18 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::ops::Range;
 
-/// Springs per partition: a sixteenth of the springs, within these bounds. Large systems
-/// get partitions big enough that windows overlap little (the cloth-256 workload: 24 of
-/// 16k springs); a 6k-spring jelly still gets seven to share between cores. A function of
-/// the spring count alone, so the summation order never depends on the thread count.
-const PARTITION: (usize, usize) = (1 << 10, 1 << 14);
+/// Springs per partition: a sixteenth of the springs, within these bounds, then evened
+/// out so that the partitions are of one size. Large systems get partitions big enough
+/// that windows overlap little (the cloth-256 workload: 24 of 16k springs); a 6k-spring
+/// jelly gets two, as each partition costs a rayon task and a window to clear and gather,
+/// and at four RK4 stages per step those fixed costs rival the springs. A function of the
+/// spring count alone, so the summation order never depends on the thread count.
+const PARTITION: (usize, usize) = (PARTITION_MIN, 1 << 14);
+const PARTITION_MIN: usize = 1 << 12;
 
 fn partition_size(springs: usize) -> usize {
-    (springs / 16).clamp(PARTITION.0, PARTITION.1)
+    let target = (springs / 16).clamp(PARTITION.0, PARTITION.1);
+    springs.div_ceil(springs.div_ceil(target).max(1)).max(1)
 }
 
 /// Particles per reduction block: the gather adds external forces (a force field sample,
@@ -161,12 +165,18 @@ pub(crate) fn scatter_springs<const UNIFORM: bool>(
     // store once, instead of a store-to-load chain through memory per spring.
     let mut current = lo;
     let mut pull = Vec3::zeros();
+    let (mut lower, mut xi, mut vi) = (usize::MAX, Vec3::zeros(), Vec3::zeros());
     for (b, (ends, rest)) in ends.chunks(LANES).zip(rest.chunks(LANES)).enumerate() {
         let n = ends.len().min(rest.len()).min(LANES);
         for l in 0..n {
             let [i, j] = ends[l];
             let (i, j) = (i as usize, j as usize);
-            lanes.set(l, (&(x[i] - x[j]), &(v[i] - v[j])), rest[l]);
+            // Consecutive springs mostly share their lower end: load it once per run.
+            if i != lower {
+                lower = i;
+                (xi, vi) = (x[i], v[i]);
+            }
+            lanes.set(l, (&(xi - x[j]), &(vi - v[j])), rest[l]);
             if !UNIFORM {
                 [lanes.ks[l], lanes.kd[l]] = params[param[b * LANES + l] as usize];
             }

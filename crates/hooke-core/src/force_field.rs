@@ -19,6 +19,10 @@ pub const FIELD_HALF_EXTENT: f64 = 2.0;
 pub struct ForceField {
     resolution: usize,
     values: Vec<Vec3>,
+    /// Node spacing and its inverse, computed once: [`ForceField::sample`] runs per particle
+    /// per force evaluation, and two divisions there cost as much as the interpolation.
+    h: f64,
+    inv_h: f64,
 }
 
 impl ForceField {
@@ -28,7 +32,13 @@ impl ForceField {
         let expected = resolution
             .checked_mul(resolution)?
             .checked_mul(resolution)?;
-        (resolution > 0 && values.len() == expected).then_some(Self { resolution, values })
+        let cells = resolution.saturating_sub(1).max(1) as f64;
+        (resolution > 0 && values.len() == expected).then_some(Self {
+            resolution,
+            values,
+            h: 2.0 * FIELD_HALF_EXTENT / cells,
+            inv_h: cells / (2.0 * FIELD_HALF_EXTENT),
+        })
     }
 
     /// Grid resolution `r`.
@@ -47,8 +57,7 @@ impl ForceField {
         if r == 1 {
             return self.values[0];
         }
-        let h = 2.0 * FIELD_HALF_EXTENT / (r - 1) as f64;
-        let inv_h = (r - 1) as f64 / (2.0 * FIELD_HALF_EXTENT);
+        let (h, inv_h) = (self.h, self.inv_h);
         // Cell index and fraction along one axis, with the point clamped to the box and the
         // last node folded into the last cell so that `index + 1` stays on the grid.
         let axis = |x: f64| -> (usize, f64) {

@@ -90,6 +90,8 @@ impl Model {
     /// resolved it this step, kept while it has not moved since (the implicit integrator
     /// holds stuck particles in place, so they are not re-detected). Explicit integrators
     /// ignore it.
+    ///
+    /// Returns whether any response ran (the model has velocity-level colliders).
     pub fn resolve_contacts(
         &self,
         inv_mass: &[f64],
@@ -97,9 +99,9 @@ impl Model {
         x: &mut [Vec3],
         v: &mut [Vec3],
         stuck: &mut [bool],
-    ) {
+    ) -> bool {
         if self.colliders.iter().all(|c| c.response.is_force()) {
-            return;
+            return false;
         }
         let resolve = |start: usize, x: &mut [Vec3], v: &mut [Vec3], stuck: &mut [bool]| {
             for k in 0..x.len() {
@@ -126,6 +128,7 @@ impl Model {
         };
         // Mesh queries cost microseconds each, so even small blocks are worth sharing.
         parallel::for_blocks3(CONTACT_BLOCK, x, v, stuck, resolve);
+        true
     }
 
     /// Total potential energy in joules: springs, gravity (zero at the origin) and penalty

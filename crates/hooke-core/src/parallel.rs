@@ -35,14 +35,30 @@ pub(crate) fn for_blocks3<C: Send>(
     c: &mut [C],
     f: impl Fn(usize, &mut [Vec3], &mut [Vec3], &mut [C]) + Sync + Send,
 ) {
+    all_blocks3(block, a, b, c, |start, a, b, c| {
+        f(start, a, b, c);
+        true
+    });
+}
+
+/// [`for_blocks3`] where `f` also reports something about its block: whether every block
+/// reported `true`. Every block runs, whatever the others report.
+pub(crate) fn all_blocks3<C: Send>(
+    block: usize,
+    a: &mut [Vec3],
+    b: &mut [Vec3],
+    c: &mut [C],
+    f: impl Fn(usize, &mut [Vec3], &mut [Vec3], &mut [C]) -> bool + Sync + Send,
+) -> bool {
     if a.len() <= block {
-        f(0, a, b, c);
+        f(0, a, b, c)
     } else {
         a.par_chunks_mut(block)
             .zip(b.par_chunks_mut(block))
             .zip(c.par_chunks_mut(block))
             .enumerate()
-            .for_each(|(k, ((a, b), c))| f(k * block, a, b, c));
+            .map(|(k, ((a, b), c))| f(k * block, a, b, c))
+            .reduce(|| true, |p, q| p & q)
     }
 }
 
@@ -68,25 +84,29 @@ pub(crate) fn find_first<T: Send>(
 /// Whether every position component is within `bound` (so finite) and every velocity is
 /// finite: a branch-free scan the compiler vectorises, run on every step.
 pub(crate) fn all_sane(x: &[Vec3], v: &[Vec3], bound: f64) -> bool {
-    // And-ing comparison results (not max, which skips NaN) keeps the loop branch-free and
-    // vectorised; NaN fails every comparison, so it counts as out of bounds.
-    let block = |x: &[Vec3], v: &[Vec3]| {
-        let mut ok = true;
-        for p in x {
-            ok &= (p.x.abs() <= bound) & (p.y.abs() <= bound) & (p.z.abs() <= bound);
-        }
-        for p in v {
-            ok &= p.x.is_finite() & p.y.is_finite() & p.z.is_finite();
-        }
-        ok
-    };
     if x.len() <= SCAN_BLOCK {
-        block(x, v)
+        sane(x, v, bound)
     } else {
         x.par_chunks(SCAN_BLOCK)
             .zip(v.par_chunks(SCAN_BLOCK))
-            .all(|(x, v)| block(x, v))
+            .all(|(x, v)| sane(x, v, bound))
     }
+}
+
+/// [`all_sane`] for one block, inline: for integrators that check each block of particles
+/// right after updating it, while it is still in cache.
+#[inline]
+pub(crate) fn sane(x: &[Vec3], v: &[Vec3], bound: f64) -> bool {
+    // And-ing comparison results (not max, which skips NaN) keeps the loop branch-free and
+    // vectorised; NaN fails every comparison, so it counts as out of bounds.
+    let mut ok = true;
+    for p in x {
+        ok &= (p.x.abs() <= bound) & (p.y.abs() <= bound) & (p.z.abs() <= bound);
+    }
+    for p in v {
+        ok &= p.x.is_finite() & p.y.is_finite() & p.z.is_finite();
+    }
+    ok
 }
 
 /// Elements per block of the vector helpers below.

@@ -81,6 +81,7 @@ impl Integrator {
     /// Advances `particles` by `dt` seconds under `model`, without collision responses.
     pub fn step(self, model: &Model, particles: &mut Particles, dt: f64, ws: &mut Workspace) {
         ws.ensure(model, particles.len());
+        ws.sane = None;
         match self {
             Self::Euler => euler::step(model, particles, dt, ws),
             Self::Symplectic => symplectic::step(model, particles, dt, ws),
@@ -132,6 +133,9 @@ pub struct Workspace {
     pub(crate) stuck: Vec<bool>,
     /// The force loop's compilation, when not the detected one.
     pub(crate) kernel: Option<Kernel>,
+    /// Whether the integrator found the state it wrote within [`crate::SANE_BOUND`], for
+    /// schemes that check it in their last pass; `None` leaves the check to the simulation.
+    pub(crate) sane: Option<bool>,
 }
 
 impl Workspace {
