@@ -54,6 +54,16 @@ pub struct Attachment {
 const CONTACT_BLOCK: usize = 256;
 
 impl Model {
+    /// Whether gravity is the only force besides the springs (no field, drag, penalty
+    /// colliders or attachments): integrators then use a loop without the per-particle
+    /// tests of [`Model::external_force`], whose result it equals to the bit.
+    pub fn gravity_only(&self) -> bool {
+        self.field.is_none()
+            && self.drag == 0.0
+            && self.attachments.is_empty()
+            && self.colliders.iter().all(|c| !c.response.is_force())
+    }
+
     /// Every force on one particle except its springs': gravity, field, drag, penalties.
     #[inline]
     pub fn external_force(&self, mass: f64, x: &Vec3, v: &Vec3) -> Vec3 {

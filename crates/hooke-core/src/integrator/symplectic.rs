@@ -12,6 +12,16 @@ use crate::particles::{Particles, Vec3};
 use crate::simulation::SANE_BOUND;
 
 pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) {
+    if model.gravity_only() {
+        update::<true>(model, p, dt, ws);
+    } else {
+        update::<false>(model, p, dt, ws);
+    }
+}
+
+/// The step; with `GRAVITY_ONLY` (see [`Model::gravity_only`]) the external force is
+/// `m g`, without the general per-particle tests.
+fn update<const GRAVITY_ONLY: bool>(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) {
     ws.assembly.scatter(&p.x, &p.v);
     let asm = &ws.assembly;
     let (mass, inv_mass) = (&p.mass, &p.inv_mass);
@@ -21,16 +31,21 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
         let chunks = x.chunks_mut(REDUCE_BLOCK).zip(v.chunks_mut(REDUCE_BLOCK));
         for (c, ((x, v), x0)) in chunks.zip(x0.chunks_mut(REDUCE_BLOCK)).enumerate() {
             let start = start + c * REDUCE_BLOCK;
-            let springs = &mut springs[..x.len()];
+            let n = x.len().min(v.len()).min(x0.len());
+            let springs = &mut springs[..n];
             asm.gather_block(start, springs);
-            for k in 0..x.len() {
-                let i = start + k;
+            let (mass, inv_mass) = (&mass[start..start + n], &inv_mass[start..start + n]);
+            for k in 0..n {
                 x0[k] = x[k];
-                if inv_mass[i] == 0.0 {
+                if inv_mass[k] == 0.0 {
                     continue;
                 }
-                let f = Assembly::force(model, mass[i], &x[k], &v[k], i, springs[k]);
-                v[k] += f * inv_mass[i] * dt;
+                let f = if GRAVITY_ONLY {
+                    model.gravity * mass[k] + springs[k]
+                } else {
+                    Assembly::force(model, mass[k], &x[k], &v[k], start + k, springs[k])
+                };
+                v[k] += f * inv_mass[k] * dt;
                 x[k] += v[k] * dt;
             }
             sane &= parallel::sane(x, v, SANE_BOUND);
