@@ -160,7 +160,7 @@ pub(crate) fn scatter_springs<const UNIFORM: bool>(
         lanes.ks = [ks; LANES];
         lanes.kd = [kd; LANES];
     }
-    let mut f = [[0.0; LANES]; 3];
+    let mut f = [[0.0; 3]; LANES];
     // Springs sharing a lower end are consecutive: sum their pull on it in a register and
     // store once, instead of a store-to-load chain through memory per spring.
     let mut current = lo;
@@ -185,7 +185,7 @@ pub(crate) fn scatter_springs<const UNIFORM: bool>(
         for l in 0..n {
             let [i, j] = ends[l];
             let (i, j) = (i as usize, j as usize);
-            let f = Vec3::new(f[0][l], f[1][l], f[2][l]);
+            let f = Vec3::from(f[l]);
             if i != current {
                 force[current - lo] += pull;
                 pull = Vec3::zeros();

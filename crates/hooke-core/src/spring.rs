@@ -82,16 +82,16 @@ pub(crate) fn spring_force(d: Vec3, dv: Vec3, rest: f64, ks: f64, kd: f64) -> Ve
     s.set(0, (&d, &dv), rest);
     s.ks = [ks];
     s.kd = [kd];
-    let mut f = [[0.0]; 3];
+    let mut f = [[0.0; 3]];
     spring_lanes(&s, 1, &mut f);
-    Vec3::new(f[0][0], f[1][0], f[2][0])
+    Vec3::from(f[0])
 }
 
 /// `L` springs' inputs, one array per component, for [`spring_lanes`].
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Lanes<const L: usize> {
-    pub d: [[f64; L]; 3],
-    pub dv: [[f64; L]; 3],
+    pub d: [[f64; 3]; L],
+    pub dv: [[f64; 3]; L],
     pub rest: [f64; L],
     pub ks: [f64; L],
     pub kd: [f64; L],
@@ -100,8 +100,8 @@ pub(crate) struct Lanes<const L: usize> {
 impl<const L: usize> Default for Lanes<L> {
     fn default() -> Self {
         Self {
-            d: [[0.0; L]; 3],
-            dv: [[0.0; L]; 3],
+            d: [[0.0; 3]; L],
+            dv: [[0.0; 3]; L],
             rest: [0.0; L],
             ks: [0.0; L],
             kd: [0.0; L],
@@ -113,10 +113,8 @@ impl<const L: usize> Lanes<L> {
     /// Sets lane `l`'s end differences and rest length.
     #[inline(always)]
     pub fn set(&mut self, l: usize, (d, dv): (&Vec3, &Vec3), rest: f64) {
-        for c in 0..3 {
-            self.d[c][l] = d[c];
-            self.dv[c][l] = dv[c];
-        }
+        self.d[l] = [d.x, d.y, d.z];
+        self.dv[l] = [dv.x, dv.y, dv.z];
         self.rest[l] = rest;
     }
 }
@@ -126,12 +124,11 @@ impl<const L: usize> Lanes<L> {
 /// so the compiler vectorises it at the target's full width: square roots and divisions,
 /// the bottleneck of a spring, then run several springs per instruction.
 #[inline(always)]
-pub(crate) fn spring_lanes<const L: usize>(s: &Lanes<L>, n: usize, f: &mut [[f64; L]; 3]) {
-    let [dx, dy, dz] = &s.d;
-    let [vx, vy, vz] = &s.dv;
-    let [fx, fy, fz] = f;
+pub(crate) fn spring_lanes<const L: usize>(s: &Lanes<L>, n: usize, f: &mut [[f64; 3]; L]) {
     for l in 0..n.min(L) {
-        let len = (dx[l] * dx[l] + dy[l] * dy[l] + dz[l] * dz[l]).sqrt();
+        let [dx, dy, dz] = s.d[l];
+        let [vx, vy, vz] = s.dv[l];
+        let len = (dx * dx + dy * dy + dz * dz).sqrt();
         // One division instead of three: the reciprocal scales all components. A degenerate
         // spring gets a zero direction, hence zero force, never 0·∞ = NaN.
         let inv = if len < DEGENERATE_LENGTH {
@@ -139,10 +136,8 @@ pub(crate) fn spring_lanes<const L: usize>(s: &Lanes<L>, n: usize, f: &mut [[f64
         } else {
             1.0 / len
         };
-        let (ux, uy, uz) = (dx[l] * inv, dy[l] * inv, dz[l] * inv);
-        let scale = -s.ks[l] * (len - s.rest[l]) - s.kd[l] * (vx[l] * ux + vy[l] * uy + vz[l] * uz);
-        fx[l] = ux * scale;
-        fy[l] = uy * scale;
-        fz[l] = uz * scale;
+        let (ux, uy, uz) = (dx * inv, dy * inv, dz * inv);
+        let scale = -s.ks[l] * (len - s.rest[l]) - s.kd[l] * (vx * ux + vy * uy + vz * uz);
+        f[l] = [ux * scale, uy * scale, uz * scale];
     }
 }
