@@ -1,5 +1,6 @@
-//! Solver benches: one force evaluation and one step of each integrator, on the cloth-N
-//! workload (`shared/bench/cloth-workload.md`) and on a public jello world.
+//! Solver benches: one force evaluation, the spring loop in each compilation the CPU runs,
+//! and one step of each integrator, on the cloth-N workload
+//! (`shared/bench/cloth-workload.md`) and on a public jello world.
 //!
 //! `cargo bench -p hooke-tests --bench solver`; figures in `benches/README.md`.
 
@@ -9,7 +10,7 @@
 )]
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use hooke_core::{Assembly, Integrator, Vec3};
+use hooke_core::{Assembly, Integrator, Kernel, Vec3};
 use hooke_scene::{Overrides, Scene};
 use std::hint::black_box;
 use std::path::Path;
@@ -54,6 +55,20 @@ fn forces(c: &mut Criterion) {
             b.iter(|| {
                 assembly.accelerations(model, (&p.mass, &p.inv_mass), &p.x, &p.v, &mut a);
                 black_box(&a);
+            })
+        });
+    }
+    // The spring loop alone, in each compilation this CPU runs.
+    let scene = cloth(256, Integrator::Symplectic);
+    let (model, p) = (scene.simulation.model(), scene.simulation.particles());
+    group.throughput(Throughput::Elements(model.springs.len() as u64));
+    for kernel in Kernel::available() {
+        let mut assembly = Assembly::new(p.len(), &model.springs);
+        assembly.set_kernel(kernel);
+        group.bench_function(BenchmarkId::new("springs-256", kernel), |b| {
+            b.iter(|| {
+                assembly.scatter(&p.x, &p.v);
+                black_box(&assembly);
             })
         });
     }

@@ -125,6 +125,9 @@ impl<const L: usize> Lanes<L> {
 /// the bottleneck of a spring, then run several springs per instruction.
 #[inline(always)]
 pub(crate) fn spring_lanes<const L: usize>(s: &Lanes<L>, n: usize, f: &mut [[f64; 3]; L]) {
+    // An index loop over a bound the compiler can see (`n.min(L)`): it vectorises this
+    // form best, without bounds checks.
+    #[allow(clippy::needless_range_loop)]
     for l in 0..n.min(L) {
         let [dx, dy, dz] = s.d[l];
         let [vx, vy, vz] = s.dv[l];
