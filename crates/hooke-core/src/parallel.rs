@@ -3,6 +3,19 @@
 use crate::particles::Vec3;
 use rayon::prelude::*;
 
+/// Runs `f` on a worker thread of the current rayon pool (the global one outside any
+/// pool). A step makes several parallel calls; from a worker each is a cheap join, while
+/// from any other thread each would inject its jobs into the pool and sleep until they
+/// finish, which costs more than a small system's whole step. One hop per step or per
+/// `advance` instead.
+pub(crate) fn on_worker<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    if rayon::current_thread_index().is_some() {
+        f()
+    } else {
+        rayon::join(f, || ()).0
+    }
+}
+
 /// Calls `f(start, a_block, b_block)` over matching blocks of `block` particles of two
 /// per-particle arrays: in parallel when there is more than one block, inline otherwise
 /// (a rayon call costs microseconds, too much for a 512-particle jelly stepped 10k times a

@@ -129,6 +129,11 @@ impl Simulation {
     /// Advances one step: the integrator, then the velocity-level collision responses, then
     /// the divergence check.
     pub fn step(&mut self) -> Result<(), Divergence> {
+        parallel::on_worker(|| self.step_here())
+    }
+
+    /// [`Simulation::step`] on the current thread.
+    fn step_here(&mut self) -> Result<(), Divergence> {
         self.integrator.step(
             &self.model,
             &mut self.particles,
@@ -148,10 +153,12 @@ impl Simulation {
 
     /// Advances `steps` steps, stopping at the first divergence.
     pub fn advance(&mut self, steps: u64) -> Result<(), Divergence> {
-        for _ in 0..steps {
-            self.step()?;
-        }
-        Ok(())
+        parallel::on_worker(|| {
+            for _ in 0..steps {
+                self.step_here()?;
+            }
+            Ok(())
+        })
     }
 
     /// The highest-frequency estimate of the system at its current state.
