@@ -21,11 +21,11 @@ use std::ops::Range;
 
 /// Springs per partition: a sixteenth of the springs, within these bounds, then evened
 /// out so that the partitions are of one size. Large systems get partitions big enough
-/// that windows overlap little (the cloth-256 workload: 24 of 16k springs); a 6k-spring
+/// that windows overlap little (the cloth-256 workload: 16 of 24k springs); a 6k-spring
 /// jelly gets two, as each partition costs a rayon task and a window to clear and gather,
 /// and at four RK4 stages per step those fixed costs rival the springs. A function of the
 /// spring count alone, so the summation order never depends on the thread count.
-const PARTITION: (usize, usize) = (PARTITION_MIN, 1 << 14);
+const PARTITION: (usize, usize) = (PARTITION_MIN, 1 << 15);
 const PARTITION_MIN: usize = 1 << 12;
 
 fn partition_size(springs: usize) -> usize {
