@@ -42,16 +42,92 @@ pub const REDUCE_BLOCK: usize = 256;
 pub const BLOCK: usize = 1 << 12;
 const _: () = assert!(BLOCK.is_multiple_of(REDUCE_BLOCK));
 
-/// The springs of a model in the solver's layout: end pairs, rest lengths and an index into
-/// a table of distinct `(ks, kd)` pairs, one array each, so the hot loop streams 20 bytes per
-/// spring instead of the 40 of [`Spring`] (16 when all springs share one `(ks, kd)`, and
-/// `param` is left empty).
+/// The springs of a model in the solver's layout: end pairs, rest lengths (see
+/// [`RestLengths`]) and an index into a table of distinct `(ks, kd)` pairs, one array each,
+/// so the hot loop streams 10 to 20 bytes per spring instead of the 40 of [`Spring`]
+/// (`param` is left empty when all springs share one `(ks, kd)`).
 #[derive(Clone, Debug, Default)]
 struct SpringTable {
     ends: Vec<[u32; 2]>,
-    rest: Vec<f64>,
+    rest: RestLengths,
     param: Vec<u32>,
     params: Vec<[f64; 2]>,
+}
+
+/// The springs' rest lengths: grid meshes have a handful of distinct ones (13 on the
+/// cloth-512 workload), kept in a table read through a 2-byte index, which takes 6 bytes per
+/// spring off the stream the force loop reads; other meshes keep one per spring.
+#[derive(Clone, Debug)]
+enum RestLengths {
+    Indexed(Vec<u16>, Vec<f64>),
+    Each(Vec<f64>),
+}
+
+impl Default for RestLengths {
+    fn default() -> Self {
+        Self::Each(Vec::new())
+    }
+}
+
+impl RestLengths {
+    /// Indexes `rest` when it has at most 2¹⁶ distinct values (by bits).
+    fn new(rest: Vec<f64>) -> Self {
+        let mut seen: HashMap<u64, u16> = HashMap::new();
+        let mut table = Vec::new();
+        let mut index = Vec::with_capacity(rest.len());
+        for &r in &rest {
+            let k = match seen.get(&r.to_bits()) {
+                Some(&k) => k,
+                None => {
+                    let Ok(k) = u16::try_from(table.len()) else {
+                        return Self::Each(rest);
+                    };
+                    seen.insert(r.to_bits(), k);
+                    table.push(r);
+                    k
+                }
+            };
+            index.push(k);
+        }
+        Self::Indexed(index, table)
+    }
+
+    fn get(&self, k: usize) -> f64 {
+        match self {
+            Self::Indexed(index, table) => table[index[k] as usize],
+            Self::Each(rest) => rest[k],
+        }
+    }
+}
+
+/// Where the force loop reads a batch's rest lengths.
+pub(crate) trait Rest: Copy + Send + Sync {
+    /// The rest length of the `l`-th spring of the slice.
+    fn rest(self, l: usize) -> f64;
+    /// Springs `range` of the slice.
+    fn slice(self, range: Range<usize>) -> Self;
+}
+
+impl Rest for &[f64] {
+    #[inline(always)]
+    fn rest(self, l: usize) -> f64 {
+        self[l]
+    }
+    #[inline(always)]
+    fn slice(self, range: Range<usize>) -> Self {
+        &self[range]
+    }
+}
+
+impl Rest for (&[u16], &[f64]) {
+    #[inline(always)]
+    fn rest(self, l: usize) -> f64 {
+        self.1[self.0[l] as usize]
+    }
+    #[inline(always)]
+    fn slice(self, range: Range<usize>) -> Self {
+        (&self.0[range], self.1)
+    }
 }
 
 /// A symmetric 3×3 matrix: `[xx, yy, zz, xy, xz, yz]`.
@@ -145,8 +221,8 @@ const LANES: usize = 64;
 /// is, and only there can the compiler run several springs per instruction; the outer
 /// passes move data between the particles' layout and the batch's.
 #[inline(always)]
-pub(crate) fn scatter_springs<const UNIFORM: bool>(
-    (ends, rest): (&[[u32; 2]], &[f64]),
+pub(crate) fn scatter_springs<const UNIFORM: bool, R: Rest>(
+    (ends, rest): (&[[u32; 2]], R),
     (param, params): (&[u32], &[[f64; 2]]),
     (lo, force): (usize, &mut [Vec3]),
     x: &[Vec3],
@@ -166,8 +242,9 @@ pub(crate) fn scatter_springs<const UNIFORM: bool>(
     let mut current = lo;
     let mut pull = Vec3::zeros();
     let (mut lower, mut xi, mut vi) = (usize::MAX, Vec3::zeros(), Vec3::zeros());
-    for (b, (ends, rest)) in ends.chunks(LANES).zip(rest.chunks(LANES)).enumerate() {
-        let n = ends.len().min(rest.len()).min(LANES);
+    for (b, ends) in ends.chunks(LANES).enumerate() {
+        let n = ends.len().min(LANES);
+        let rest = rest.slice(b * LANES..b * LANES + n);
         for l in 0..n {
             let [i, j] = ends[l];
             let (i, j) = (i as usize, j as usize);
@@ -176,7 +253,7 @@ pub(crate) fn scatter_springs<const UNIFORM: bool>(
                 lower = i;
                 (xi, vi) = (x[i], v[i]);
             }
-            lanes.set(l, (&(xi - x[j]), &(vi - v[j])), rest[l]);
+            lanes.set(l, (&(xi - x[j]), &(vi - v[j])), rest.rest(l));
             if !UNIFORM {
                 [lanes.ks[l], lanes.kd[l]] = params[param[b * LANES + l] as usize];
             }
@@ -199,8 +276,8 @@ pub(crate) fn scatter_springs<const UNIFORM: bool>(
 }
 
 /// The arguments of [`scatter_springs`].
-pub(crate) type ScatterArgs<'a> = (
-    (&'a [[u32; 2]], &'a [f64]),
+pub(crate) type ScatterArgs<'a, R> = (
+    (&'a [[u32; 2]], R),
     (&'a [u32], &'a [[f64; 2]]),
     (usize, &'a mut [Vec3]),
     &'a [Vec3],
@@ -261,12 +338,13 @@ impl Assembly {
             (s.i.min(s.j), s.i.max(s.j))
         });
         let mut table = SpringTable::default();
+        let mut rest = Vec::with_capacity(springs.len());
         let mut seen: HashMap<[u64; 2], u32> = HashMap::new();
         for &k in &order {
             let s = &springs[k as usize];
             // Lower index first: the force on the other end is the exact negation.
             table.ends.push([s.i.min(s.j), s.i.max(s.j)]);
-            table.rest.push(s.rest);
+            rest.push(s.rest);
             let key = [s.ks.to_bits(), s.kd.to_bits()];
             let next = table.params.len() as u32;
             let index = *seen.entry(key).or_insert(next);
@@ -278,6 +356,7 @@ impl Assembly {
         if table.params.len() == 1 {
             table.param = Vec::new();
         }
+        table.rest = RestLengths::new(rest);
         let partitions: Vec<Partition> = (0..springs.len())
             .step_by(partition_size(springs.len()))
             .map(|start| {
@@ -338,13 +417,29 @@ impl Assembly {
         let scatter = |part: &mut Partition| {
             part.force.fill(Vec3::zeros());
             let r = part.springs.clone();
-            let springs = (&table.ends[r.clone()], &table.rest[r.clone()]);
+            let ends = &table.ends[r.clone()];
             let window = (part.lo, &mut part.force[..]);
-            if table.param.is_empty() {
-                kernel.scatter::<true>((springs, (&[], &table.params), window, x, v));
+            let params = if table.param.is_empty() {
+                None
             } else {
-                let params = (&table.param[r], &table.params[..]);
-                kernel.scatter::<false>((springs, params, window, x, v));
+                Some((&table.param[r.clone()], &table.params[..]))
+            };
+            let uniform = (&[][..], &table.params[..]);
+            match (&table.rest, params) {
+                (RestLengths::Indexed(index, rests), None) => {
+                    let rest = (&index[r], &rests[..]);
+                    kernel.scatter::<true, _>(((ends, rest), uniform, window, x, v))
+                }
+                (RestLengths::Indexed(index, rests), Some(params)) => {
+                    let rest = (&index[r], &rests[..]);
+                    kernel.scatter::<false, _>(((ends, rest), params, window, x, v))
+                }
+                (RestLengths::Each(rest), None) => {
+                    kernel.scatter::<true, _>(((ends, &rest[r]), uniform, window, x, v))
+                }
+                (RestLengths::Each(rest), Some(params)) => {
+                    kernel.scatter::<false, _>(((ends, &rest[r]), params, window, x, v))
+                }
             }
         };
         each_partition(&mut self.partitions, scatter);
@@ -394,7 +489,7 @@ impl Assembly {
             let u = d * (1.0 / len);
             let [ks, kd] = table.params(k);
             let uu = Sym3::outer(&u);
-            let transverse = (1.0 - table.rest[k] / len).max(0.0);
+            let transverse = (1.0 - table.rest.get(k) / len).max(0.0);
             let elastic = uu
                 .scale(ks * (1.0 - transverse))
                 .plus_identity(ks * transverse);

@@ -7,7 +7,7 @@
 //! widest the CPU supports is picked at run time. This is the workspace's one use of
 //! `unsafe`: calling a function compiled for features that were checked to be present.
 
-use crate::assembly::{ScatterArgs, scatter_springs};
+use crate::assembly::{Rest, ScatterArgs, scatter_springs};
 use crate::particles::Vec3;
 use std::fmt;
 use std::str::FromStr;
@@ -68,17 +68,20 @@ impl Kernel {
 
     /// Runs the spring force loop compiled for this kernel.
     #[allow(unsafe_code)]
-    pub(crate) fn scatter<const UNIFORM: bool>(self, (springs, params, window, x, v): ScatterArgs) {
+    pub(crate) fn scatter<const UNIFORM: bool, R: Rest>(
+        self,
+        (springs, params, window, x, v): ScatterArgs<R>,
+    ) {
         match self {
-            Self::Portable => scatter_springs::<UNIFORM>(springs, params, window, x, v),
+            Self::Portable => scatter_springs::<UNIFORM, R>(springs, params, window, x, v),
             // SAFETY: a kernel other than `Portable` comes from `detect`, which checked that
             // the CPU has the features these functions are compiled for.
             #[cfg(target_arch = "x86_64")]
-            Self::Avx2 => unsafe { scatter_avx2::<UNIFORM>(springs, params, window, x, v) },
+            Self::Avx2 => unsafe { scatter_avx2::<UNIFORM, R>(springs, params, window, x, v) },
             #[cfg(target_arch = "x86_64")]
-            Self::Avx512 => unsafe { scatter_avx512::<UNIFORM>(springs, params, window, x, v) },
+            Self::Avx512 => unsafe { scatter_avx512::<UNIFORM, R>(springs, params, window, x, v) },
             #[cfg(not(target_arch = "x86_64"))]
-            _ => scatter_springs::<UNIFORM>(springs, params, window, x, v),
+            _ => scatter_springs::<UNIFORM, R>(springs, params, window, x, v),
         }
     }
 }
@@ -120,27 +123,27 @@ impl Ord for Kernel {
 /// The spring force loop compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn scatter_avx2<const UNIFORM: bool>(
-    springs: (&[[u32; 2]], &[f64]),
+fn scatter_avx2<const UNIFORM: bool, R: Rest>(
+    springs: (&[[u32; 2]], R),
     params: (&[u32], &[[f64; 2]]),
     window: (usize, &mut [Vec3]),
     x: &[Vec3],
     v: &[Vec3],
 ) {
-    scatter_springs::<UNIFORM>(springs, params, window, x, v);
+    scatter_springs::<UNIFORM, R>(springs, params, window, x, v);
 }
 
 /// The spring force loop compiled for AVX-512.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
-fn scatter_avx512<const UNIFORM: bool>(
-    springs: (&[[u32; 2]], &[f64]),
+fn scatter_avx512<const UNIFORM: bool, R: Rest>(
+    springs: (&[[u32; 2]], R),
     params: (&[u32], &[[f64; 2]]),
     window: (usize, &mut [Vec3]),
     x: &[Vec3],
     v: &[Vec3],
 ) {
-    scatter_springs::<UNIFORM>(springs, params, window, x, v);
+    scatter_springs::<UNIFORM, R>(springs, params, window, x, v);
 }
 
 #[cfg(test)]
@@ -149,9 +152,9 @@ mod tests {
     use crate::assembly::Assembly;
     use crate::spring::{Spring, SpringKind};
 
-    /// A deterministic jumble of particles and springs: random ends, lengths from 0 (a
-    /// degenerate spring) to far stretched, and several `(ks, kd)` pairs or just one.
-    fn jumble(uniform: bool) -> (Vec<Vec3>, Vec<Vec3>, Vec<Spring>) {
+    /// A deterministic jumble of particles and `count` springs: random ends, lengths from 0
+    /// (a degenerate spring) to far stretched, and several `(ks, kd)` pairs or just one.
+    fn jumble(uniform: bool, count: usize) -> (Vec<Vec3>, Vec<Vec3>, Vec<Spring>) {
         let mut seed = 0x2545_f491_4f6c_dd1d_u64;
         let mut next = move || {
             seed ^= seed << 13;
@@ -173,7 +176,7 @@ mod tests {
             kd: 0.5,
             kind: SpringKind::Other,
         }];
-        for k in 0..20_000 {
+        for k in 0..count {
             let i = (next() * n as f64) as u32;
             // Mostly near neighbours, as in a mesh, sometimes anywhere.
             let j = if k % 7 == 0 {
@@ -203,8 +206,9 @@ mod tests {
 
     #[test]
     fn every_kernel_gives_the_same_bits() {
-        for uniform in [true, false] {
-            let (x, v, springs) = jumble(uniform);
+        // Over 65536 distinct rest lengths are stored per spring instead of indexed.
+        for (uniform, count) in [(true, 20_000), (false, 20_000), (true, 70_000)] {
+            let (x, v, springs) = jumble(uniform, count);
             let forces = |kernel: Kernel| {
                 let mut asm = Assembly::new(x.len(), &springs);
                 asm.set_kernel(kernel);
@@ -235,7 +239,10 @@ mod tests {
                         .zip(b.iter())
                         .all(|(a, b)| a.to_bits() == b.to_bits())
                 });
-                assert!(same, "{kernel} differs from portable (uniform: {uniform})");
+                assert!(
+                    same,
+                    "{kernel} differs from portable ({count}, uniform: {uniform})"
+                );
             }
         }
     }
