@@ -70,6 +70,29 @@ fn a_world_has_the_course_springs_and_rest_lengths() {
     assert_eq!(scene.simulation.model().gravity, hooke_core::Vec3::zeros());
 }
 
+/// jello.w's field is zero everywhere and is left out of the model (the solver skips
+/// sampling it); rotate.w's is kept.
+#[test]
+fn zero_fields_are_left_out_and_others_kept() {
+    let model_of = |name: &str| world(name).to_scene(name).build(Path::new(".")).unwrap();
+    let jello = model_of("jello");
+    assert!(
+        world("jello")
+            .field
+            .iter()
+            .all(|v| *v == hooke_core::Vec3::zeros())
+    );
+    assert!(jello.simulation.model().field.is_none());
+    let rotate = model_of("rotate");
+    let field = rotate
+        .simulation
+        .model()
+        .field
+        .as_ref()
+        .expect("rotate.w has a field");
+    assert!(!field.is_zero());
+}
+
 #[test]
 fn public_world_trajectories() {
     for name in WORLDS {

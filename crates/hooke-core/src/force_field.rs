@@ -46,6 +46,11 @@ impl ForceField {
         self.resolution
     }
 
+    /// Whether every node value is zero: such a field exerts no force anywhere.
+    pub fn is_zero(&self) -> bool {
+        self.values.iter().all(|v| *v == Vec3::zeros())
+    }
+
     /// The node values in file order.
     pub fn values(&self) -> &[Vec3] {
         &self.values

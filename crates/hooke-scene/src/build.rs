@@ -366,7 +366,7 @@ impl SceneSpec {
             Some(f) => {
                 let values = f.values.iter().map(vec3).collect::<Vec<_>>();
                 let found = values.len();
-                Some(ForceField::new(f.resolution, values).ok_or_else(|| {
+                let field = ForceField::new(f.resolution, values).ok_or_else(|| {
                     invalid(
                         "force_field.values",
                         format!(
@@ -374,7 +374,11 @@ impl SceneSpec {
                             f.resolution.saturating_pow(3)
                         ),
                     )
-                })?)
+                })?;
+                // A field that is zero everywhere (as in most of the course's worlds) adds
+                // nothing, and sampling it costs a fifth of a jelly's step: leave it out.
+                // Forces are the same numbers (at most a -0 becomes +0).
+                (!field.is_zero()).then_some(field)
             }
         };
         let model = Model {
