@@ -19,9 +19,10 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::ops::Range;
 
-/// Springs per partition: a sixteenth of the springs, within these bounds, then evened
-/// out so that the partitions are of one size. Large systems get partitions big enough
-/// that windows overlap little (the cloth-256 workload: 16 of 24k springs); a 6k-spring
+/// Springs per partition: a thirty-second of the springs, within these bounds, then evened
+/// out so that the partitions are of one size. Large systems get enough partitions for
+/// two threads to finish together (the cloth-256 workload: 32 of 12k springs), each big
+/// enough that windows overlap little (at most 32k springs); a 6k-spring
 /// jelly gets two, as each partition costs a rayon task and a window to clear and gather,
 /// and at four RK4 stages per step those fixed costs rival the springs. A function of the
 /// spring count alone, so the summation order never depends on the thread count.
@@ -29,7 +30,7 @@ const PARTITION: (usize, usize) = (PARTITION_MIN, 1 << 15);
 const PARTITION_MIN: usize = 1 << 12;
 
 fn partition_size(springs: usize) -> usize {
-    let target = (springs / 16).clamp(PARTITION.0, PARTITION.1);
+    let target = (springs / 32).clamp(PARTITION.0, PARTITION.1);
     springs.div_ceil(springs.div_ceil(target).max(1)).max(1)
 }
 
