@@ -17,8 +17,16 @@ use std::str::FromStr;
 /// each lane does the same correctly rounded operations in the same order: every kernel
 /// gives the same bits, as a test checks. Wider vectors pay where a spring's cost is, its
 /// square root and division, whose throughput per instruction does not depend on the
-/// width on current x86 cores.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// width on current x86 cores. Kernels are ordered narrowest first.
+///
+/// ```
+/// use hooke_core::Kernel;
+/// // Every CPU runs the portable loop; the widest available one is the default.
+/// assert_eq!(Kernel::available()[0], Kernel::Portable);
+/// assert!(Kernel::detect() >= Kernel::Portable);
+/// assert_eq!("avx512".parse::<Kernel>(), Ok(Kernel::Avx512));
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Kernel {
     /// Baseline x86-64 (SSE2), or whatever the target compiles for elsewhere.
     #[default]
@@ -105,18 +113,6 @@ impl FromStr for Kernel {
             .into_iter()
             .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
             .ok_or_else(|| UnknownKernel(s.to_string()))
-    }
-}
-
-impl PartialOrd for Kernel {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for Kernel {
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        (*self as u8).cmp(&(*other as u8))
     }
 }
 
