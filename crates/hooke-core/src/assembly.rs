@@ -22,15 +22,19 @@ use std::ops::Range;
 /// Springs per partition: a thirty-second of the springs, within these bounds, then evened
 /// out so that the partitions are of one size. Large systems get enough partitions for
 /// two threads to finish together (the cloth-256 workload: 32 of 12k springs), each big
-/// enough that windows overlap little (at most 32k springs); a 6k-spring
-/// jelly gets two, as each partition costs a rayon task and a window to clear and gather,
-/// and at four RK4 stages per step those fixed costs rival the springs. A function of the
-/// spring count alone, so the summation order never depends on the thread count.
+/// enough that windows overlap little (at most 32k springs); a 6k-spring jelly or a
+/// 3.5k-spring cloth gets two, as each partition costs a rayon task and a window to clear
+/// and gather, and at four RK4 stages per step those fixed costs rival the springs. A
+/// function of the spring count alone, so the summation order never depends on the thread
+/// count.
 const PARTITION: (usize, usize) = (PARTITION_MIN, 1 << 15);
 const PARTITION_MIN: usize = 1 << 12;
 
 fn partition_size(springs: usize) -> usize {
-    let target = (springs / 32).clamp(PARTITION.0, PARTITION.1);
+    // From 2k to 8k springs (a small cloth, a jelly) two halves, not one partition: the
+    // implicit integrator runs its products partition by partition 150 times a step.
+    let min = PARTITION.0.min(springs.div_ceil(2)).max(PARTITION.0 / 4);
+    let target = (springs / 32).clamp(min, PARTITION.1);
     springs.div_ceil(springs.div_ceil(target).max(1)).max(1)
 }
 
