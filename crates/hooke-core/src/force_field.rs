@@ -74,11 +74,9 @@ impl ForceField {
         let (a, tx) = axis(p.x);
         let (b, ty) = axis(p.y);
         let (c, tz) = axis(p.z);
-        // The cell's eight corners lie in one stretch of the array from its lowest corner:
-        // one bounds check for the stretch, none per corner.
-        let base = a * r * r + b * r + c;
-        let cell = &self.values[base..=base + r * r + r + 1];
-        let at = |da: usize, db: usize, dc: usize| cell[da * r * r + db * r + dc];
+        let at = |da: usize, db: usize, dc: usize| {
+            self.values[(a + da) * r * r + (b + db) * r + (c + dc)]
+        };
         let lerp = |u: Vec3, w: Vec3, t: f64| u * (1.0 - t) + w * t;
         let x00 = lerp(at(0, 0, 0), at(1, 0, 0), tx);
         let x10 = lerp(at(0, 1, 0), at(1, 1, 0), tx);
