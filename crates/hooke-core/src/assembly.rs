@@ -221,7 +221,7 @@ const LANES: usize = 64;
 /// spring `k` has `params[param[k]]`.
 ///
 /// Springs go in batches of [`LANES`], in three passes: load each spring's end
-/// differences into component arrays, compute the batch's forces in one vectorised loop
+/// differences into the batch's arrays, compute the batch's forces in one vectorised loop
 /// ([`spring_lanes`]), then add them to the ends. The middle pass is where the arithmetic
 /// is, and only there can the compiler run several springs per instruction; the outer
 /// passes move data between the particles' layout and the batch's.

@@ -87,7 +87,8 @@ pub(crate) fn spring_force(d: Vec3, dv: Vec3, rest: f64, ks: f64, kd: f64) -> Ve
     Vec3::from(f[0])
 }
 
-/// `L` springs' inputs, one array per component, for [`spring_lanes`].
+/// `L` springs' inputs for [`spring_lanes`]: each spring's vectors whole (the compiler
+/// deinterleaves them in the vector loop), rest length, stiffness and damping.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Lanes<const L: usize> {
     pub d: [[f64; 3]; L],
@@ -119,7 +120,7 @@ impl<const L: usize> Lanes<L> {
     }
 }
 
-/// [`spring_force`] for the first `n` of `L` springs side by side, component arrays in and
+/// [`spring_force`] for the first `n` of `L` springs side by side, one force per spring
 /// out. The loop body has no branch (the degenerate case is a select after the division),
 /// so the compiler vectorises it at the target's full width: square roots and divisions,
 /// the bottleneck of a spring, then run several springs per instruction.
