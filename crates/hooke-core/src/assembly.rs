@@ -74,23 +74,28 @@ impl Default for RestLengths {
     }
 }
 
+/// The index of `value` in `table`, which holds distinct values (told apart by `key`),
+/// appending it when new.
+fn intern<K: std::hash::Hash + Eq, V>(
+    seen: &mut HashMap<K, usize>,
+    table: &mut Vec<V>,
+    key: K,
+    value: V,
+) -> usize {
+    *seen.entry(key).or_insert_with(|| {
+        table.push(value);
+        table.len() - 1
+    })
+}
+
 impl RestLengths {
     /// Indexes `rest` when it has at most 2¹⁶ distinct values (by bits).
     fn new(rest: Vec<f64>) -> Self {
-        let mut seen: HashMap<u64, u16> = HashMap::new();
-        let mut table = Vec::new();
+        let (mut seen, mut table) = (HashMap::new(), Vec::new());
         let mut index = Vec::with_capacity(rest.len());
         for &r in &rest {
-            let k = match seen.get(&r.to_bits()) {
-                Some(&k) => k,
-                None => {
-                    let Ok(k) = u16::try_from(table.len()) else {
-                        return Self::Each(rest);
-                    };
-                    seen.insert(r.to_bits(), k);
-                    table.push(r);
-                    k
-                }
+            let Ok(k) = u16::try_from(intern(&mut seen, &mut table, r.to_bits(), r)) else {
+                return Self::Each(rest);
             };
             index.push(k);
         }
@@ -344,19 +349,15 @@ impl Assembly {
         });
         let mut table = SpringTable::default();
         let mut rest = Vec::with_capacity(springs.len());
-        let mut seen: HashMap<[u64; 2], u32> = HashMap::new();
+        let mut seen = HashMap::new();
         for &k in &order {
             let s = &springs[k as usize];
             // Lower index first: the force on the other end is the exact negation.
             table.ends.push([s.i.min(s.j), s.i.max(s.j)]);
             rest.push(s.rest);
             let key = [s.ks.to_bits(), s.kd.to_bits()];
-            let next = table.params.len() as u32;
-            let index = *seen.entry(key).or_insert(next);
-            if index == next {
-                table.params.push([s.ks, s.kd]);
-            }
-            table.param.push(index);
+            let index = intern(&mut seen, &mut table.params, key, [s.ks, s.kd]);
+            table.param.push(index as u32);
         }
         if table.params.len() == 1 {
             table.param = Vec::new();
@@ -451,7 +452,7 @@ impl Assembly {
     }
 
     /// Scatters an antisymmetric per-spring quantity: `g(k, i, j)` is added at the spring's
-    /// lower end `i` and subtracted at `j`; [`Assembly::gathered`] then reads the sums.
+    /// lower end `i` and subtracted at `j`; [`Assembly::map_gathered`] then reads the sums.
     /// `k` indexes the assembly's own (sorted) spring order, as [`Assembly::spring_blocks`]
     /// does. This is how the implicit integrator multiplies by its system matrix.
     pub fn scatter_pairs(&mut self, g: impl Fn(usize, usize, usize) -> Vec3 + Sync) {
@@ -510,36 +511,23 @@ impl Assembly {
         }
     }
 
-    /// The sum at particle `p` of the last scatter: its total spring force after
-    /// [`Assembly::scatter`], its row of the product after [`Assembly::scatter_pairs`].
-    #[inline]
-    pub fn gathered(&self, p: usize) -> Vec3 {
-        let b = p / REDUCE_BLOCK;
-        let parts =
-            &self.block_parts[self.block_start[b] as usize..self.block_start[b + 1] as usize];
-        let mut f = Vec3::zeros();
-        for &q in parts {
-            let part = &self.partitions[q as usize];
-            if let Some(g) = p.checked_sub(part.lo).and_then(|w| part.force.get(w)) {
-                f += g;
-            }
-        }
-        f
+    /// The partitions whose window meets reduction block `b`, in order.
+    fn block_parts(&self, b: usize) -> &[u32] {
+        &self.block_parts[self.block_start[b] as usize..self.block_start[b + 1] as usize]
     }
 
-    /// The spring sums of the last scatter (see [`Assembly::gathered`]) for particles
-    /// `start..start + out.len()`, a block that starts on a multiple of [`REDUCE_BLOCK`] and
-    /// spans at most one. Adds each window's overlap with the block as one slice, so the
-    /// per-particle loops that follow do no window lookups; the sums are the same bits as
-    /// [`Assembly::gathered`].
+    /// The sums of the last scatter for particles `start..start + out.len()`, a block that
+    /// starts on a multiple of [`REDUCE_BLOCK`] and spans at most one: each particle's total
+    /// spring force after [`Assembly::scatter`], its row of the product after
+    /// [`Assembly::scatter_pairs`]. Each particle's sum adds the windows holding it in
+    /// partition order, so the bits do not depend on the thread count; each window's
+    /// overlap with the block is added as one slice, so the per-particle loops that follow
+    /// do no window lookups.
     pub(crate) fn gather_block(&self, start: usize, out: &mut [Vec3]) {
         debug_assert!(start.is_multiple_of(REDUCE_BLOCK) && out.len() <= REDUCE_BLOCK);
         out.fill(Vec3::zeros());
-        let b = start / REDUCE_BLOCK;
         let end = start + out.len();
-        let parts =
-            &self.block_parts[self.block_start[b] as usize..self.block_start[b + 1] as usize];
-        for &q in parts {
+        for &q in self.block_parts(start / REDUCE_BLOCK) {
             let part = &self.partitions[q as usize];
             let (lo, hi) = (part.lo.max(start), (part.lo + part.force.len()).min(end));
             if lo < hi {
@@ -574,11 +562,18 @@ impl Assembly {
         map: impl Fn(usize, Vec3) -> Vec3 + Sync + Send,
     ) {
         self.scatter(x, v);
+        self.map_gathered(out, |p, springs| {
+            map(p, Self::force(model, mass[p], &x[p], &v[p], p, springs))
+        });
+    }
+
+    /// Sets `out[p] = map(p, S_p)` for every particle, `S_p` its sum from the last scatter
+    /// (see [`Assembly::gather_block`]), in parallel blocks.
+    pub fn map_gathered(&self, out: &mut [Vec3], map: impl Fn(usize, Vec3) -> Vec3 + Sync + Send) {
         let block = |start: usize, out: &mut [Vec3]| {
             self.gather_block(start, out);
             for (k, o) in out.iter_mut().enumerate() {
-                let p = start + k;
-                *o = map(p, Self::force(model, mass[p], &x[p], &v[p], p, *o));
+                *o = map(start + k, *o);
             }
         };
         if out.len() <= REDUCE_BLOCK {

@@ -210,7 +210,9 @@ mod tests {
                 asm.set_kernel(kernel);
                 assert_eq!(asm.kernel(), kernel);
                 asm.scatter(&x, &v);
-                (0..x.len()).map(|p| asm.gathered(p)).collect::<Vec<_>>()
+                let mut f = vec![Vec3::zeros(); x.len()];
+                asm.map_gathered(&mut f, |_, sum| sum);
+                f
             };
             let portable = forces(Kernel::Portable);
             // The layout sums the same forces as a naive loop over the springs, in another

@@ -67,13 +67,12 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
         asm.scatter_pairs(|k, i, j| blocks[k][0].mul(&(v[i] - v[j])));
     }
     {
-        let asm = &*asm;
         let f0 = &*f0;
-        parallel::for_each(b, |i, b| {
-            *b = if fixed(i) {
+        asm.map_gathered(b, |i, kv| {
+            if fixed(i) {
                 Vec3::zeros()
             } else {
-                (f0[i] - asm.gathered(i) * dt) * dt
+                (f0[i] - kv * dt) * dt
             }
         });
     }
@@ -103,12 +102,11 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
     let mass = &p.mass;
     let multiply = |asm: &mut crate::Assembly, from: &[Vec3], to: &mut [Vec3]| {
         asm.scatter_pairs(|k, i, j| system[k].mul(&(from[i] - from[j])));
-        let asm = &*asm;
-        parallel::for_each(to, |i, t| {
-            *t = if fixed(i) {
+        asm.map_gathered(to, |i, row| {
+            if fixed(i) {
                 Vec3::zeros()
             } else {
-                from[i] * (mass[i] + diagonal_shift) + asm.gathered(i)
+                from[i] * (mass[i] + diagonal_shift) + row
             }
         });
     };
