@@ -232,11 +232,7 @@ const LANES: usize = 64;
 /// passes move data between the particles' layout and the batch's.
 #[inline(always)]
 pub(crate) fn scatter_springs<const UNIFORM: bool, R: Rest>(
-    (ends, rest): (&[[u32; 2]], R),
-    (param, params): (&[u32], &[[f64; 2]]),
-    (lo, force): (usize, &mut [Vec3]),
-    x: &[Vec3],
-    v: &[Vec3],
+    ((ends, rest), (param, params), (lo, force), x, v): ScatterArgs<R>,
 ) {
     // Equal lengths let one bounds check on `x` cover `v` too.
     let v = &v[..x.len()];
@@ -285,7 +281,8 @@ pub(crate) fn scatter_springs<const UNIFORM: bool, R: Rest>(
     force[current - lo] += pull;
 }
 
-/// The arguments of [`scatter_springs`].
+/// The arguments of [`scatter_springs`]: the springs' ends and rest lengths, their
+/// `(ks, kd)` indices and table, the window (its first particle and forces), `x` and `v`.
 pub(crate) type ScatterArgs<'a, R> = (
     (&'a [[u32; 2]], R),
     (&'a [u32], &'a [[f64; 2]]),

@@ -8,7 +8,6 @@
 //! `unsafe`: calling a function compiled for features that were checked to be present.
 
 use crate::assembly::{Rest, ScatterArgs, scatter_springs};
-use crate::particles::Vec3;
 use std::fmt;
 use std::str::FromStr;
 
@@ -76,20 +75,17 @@ impl Kernel {
 
     /// Runs the spring force loop compiled for this kernel.
     #[allow(unsafe_code)]
-    pub(crate) fn scatter<const UNIFORM: bool, R: Rest>(
-        self,
-        (springs, params, window, x, v): ScatterArgs<R>,
-    ) {
+    pub(crate) fn scatter<const UNIFORM: bool, R: Rest>(self, args: ScatterArgs<R>) {
         match self {
-            Self::Portable => scatter_springs::<UNIFORM, R>(springs, params, window, x, v),
+            Self::Portable => scatter_springs::<UNIFORM, R>(args),
             // SAFETY: a kernel other than `Portable` comes from `detect`, which checked that
             // the CPU has the features these functions are compiled for.
             #[cfg(target_arch = "x86_64")]
-            Self::Avx2 => unsafe { scatter_avx2::<UNIFORM, R>(springs, params, window, x, v) },
+            Self::Avx2 => unsafe { scatter_avx2::<UNIFORM, R>(args) },
             #[cfg(target_arch = "x86_64")]
-            Self::Avx512 => unsafe { scatter_avx512::<UNIFORM, R>(springs, params, window, x, v) },
+            Self::Avx512 => unsafe { scatter_avx512::<UNIFORM, R>(args) },
             #[cfg(not(target_arch = "x86_64"))]
-            _ => scatter_springs::<UNIFORM, R>(springs, params, window, x, v),
+            _ => scatter_springs::<UNIFORM, R>(args),
         }
     }
 }
@@ -119,33 +115,22 @@ impl FromStr for Kernel {
 /// The spring force loop compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn scatter_avx2<const UNIFORM: bool, R: Rest>(
-    springs: (&[[u32; 2]], R),
-    params: (&[u32], &[[f64; 2]]),
-    window: (usize, &mut [Vec3]),
-    x: &[Vec3],
-    v: &[Vec3],
-) {
-    scatter_springs::<UNIFORM, R>(springs, params, window, x, v);
+fn scatter_avx2<const UNIFORM: bool, R: Rest>(args: ScatterArgs<R>) {
+    scatter_springs::<UNIFORM, R>(args);
 }
 
 /// The spring force loop compiled for AVX-512.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
-fn scatter_avx512<const UNIFORM: bool, R: Rest>(
-    springs: (&[[u32; 2]], R),
-    params: (&[u32], &[[f64; 2]]),
-    window: (usize, &mut [Vec3]),
-    x: &[Vec3],
-    v: &[Vec3],
-) {
-    scatter_springs::<UNIFORM, R>(springs, params, window, x, v);
+fn scatter_avx512<const UNIFORM: bool, R: Rest>(args: ScatterArgs<R>) {
+    scatter_springs::<UNIFORM, R>(args);
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::assembly::Assembly;
+    use crate::particles::Vec3;
     use crate::spring::{Spring, SpringKind};
 
     /// A deterministic jumble of particles and `count` springs: random ends, lengths from 0
