@@ -25,6 +25,14 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
+/// The names of the files in `dir`.
+fn file_names(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect()
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -170,10 +178,7 @@ fn bad_input_is_refused_with_the_file_and_line_and_writes_nothing() {
         assert!(!e.contains("panicked"), "{args:?} panicked:\n{e}");
         assert!(!dir.join("t.csv").exists(), "{args:?} left an output file");
     }
-    let leftovers: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
+    let leftovers = file_names(&dir);
     assert_eq!(
         leftovers.len(),
         2,
@@ -307,9 +312,8 @@ fn ctrl_c_stops_a_run_at_a_complete_frame() {
     for f in &frames {
         image::open(f).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
     }
-    let leftovers: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+    let leftovers: Vec<_> = file_names(&dir)
+        .into_iter()
         .filter(|n| n.ends_with(".tmp"))
         .collect();
     assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
