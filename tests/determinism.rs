@@ -81,7 +81,9 @@ fn every_force_kernel_gives_the_same_trajectory() {
 /// Symplectic Euler checks each block of particles for divergence as it updates it,
 /// instead of a separate scan: the first bad step must still be the one reported. At 40×
 /// the stable step the workload blows up within some steps; the state one step before
-/// the reported one is sane, and the reported particle is the first bad one.
+/// the reported one is sane, and the reported particle is the first bad one. Without
+/// contact responses no start positions are kept: the report's step-size estimate, made
+/// from positions rebuilt by undoing the step, must match the one at the actual start.
 #[test]
 fn symplectic_reports_the_first_diverged_step_and_particle() {
     let spec = || {
@@ -107,4 +109,13 @@ fn symplectic_reports_the_first_diverged_step_and_particle() {
     let after = scene.simulation.particles();
     let first_bad = (0..after.len()).find(|&i| !sane(&after.x[i], &after.v[i]));
     assert_eq!(first_bad, Some(err.particle));
+    assert!(scene.simulation.workspace().start_positions().is_none());
+    let limit = before.simulation.stability().max_dt(Integrator::Symplectic);
+    let relative = (err.suggested_dt / (0.5 * limit) - 1.0).abs();
+    assert!(
+        relative < 1e-6,
+        "suggested {:e} s, estimate at the start {:e} s",
+        err.suggested_dt,
+        limit
+    );
 }

@@ -565,7 +565,7 @@ impl Assembly {
     }
 
     /// Sets `out[p] = map(p, S_p)` for every particle, `S_p` its sum from the last scatter
-    /// (see [`Assembly::gather_block`]), in parallel blocks.
+    /// (the windows holding `p` added in partition order), in parallel blocks.
     pub fn map_gathered(&self, out: &mut [Vec3], map: impl Fn(usize, Vec3) -> Vec3 + Sync + Send) {
         let block = |start: usize, out: &mut [Vec3]| {
             self.gather_block(start, out);

@@ -64,6 +64,12 @@ impl Model {
             && self.colliders.iter().all(|c| !c.response.is_force())
     }
 
+    /// Whether any collider has a velocity-level response (restitution, stick), which
+    /// [`Model::resolve_contacts`] applies after each step from the step's start positions.
+    pub fn has_contact_responses(&self) -> bool {
+        self.colliders.iter().any(|c| !c.response.is_force())
+    }
+
     /// Every force on one particle except its springs': gravity, field, drag, penalties.
     #[inline]
     pub fn external_force(&self, mass: f64, x: &Vec3, v: &Vec3) -> Vec3 {
@@ -110,7 +116,7 @@ impl Model {
         v: &mut [Vec3],
         stuck: &mut [bool],
     ) -> bool {
-        if self.colliders.iter().all(|c| c.response.is_force()) {
+        if !self.has_contact_responses() {
             return false;
         }
         let resolve = |start: usize, x: &mut [Vec3], v: &mut [Vec3], stuck: &mut [bool]| {

@@ -187,7 +187,15 @@ impl Simulation {
             Some((particle, what)) => {
                 // Estimate at the step's start: the diverged state has no meaningful geometry.
                 let mut at_start = self.particles.clone();
-                at_start.x.copy_from_slice(&self.workspace.x0);
+                match self.workspace.start_positions() {
+                    Some(x0) => at_start.x.copy_from_slice(x0),
+                    // Symplectic Euler moved every particle by `dt v`; undone up to rounding.
+                    None => {
+                        for (x, v) in at_start.x.iter_mut().zip(&p.v) {
+                            *x -= v * self.dt;
+                        }
+                    }
+                }
                 let limit = StabilityEstimate::of(&self.model, &at_start).max_dt(self.integrator);
                 Err(Divergence {
                     step: self.step,

@@ -91,7 +91,9 @@ fn apply(model: &Model, p: &Particles, penalty_k: f64, u: &[Vec3], out: &mut [Ve
         let (i, j) = (s.i as usize, s.j as usize);
         let d = p.x[i] - p.x[j];
         let len = d.norm();
-        if len < crate::spring::DEGENERATE_LENGTH {
+        // Degenerate springs have no direction; neither do springs at a particle that has
+        // overflowed (a diverged state rebuilt by undoing the step).
+        if !(len >= crate::spring::DEGENERATE_LENGTH && len.is_finite()) {
             continue;
         }
         let dir = d / len;

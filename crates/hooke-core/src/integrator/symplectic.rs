@@ -2,7 +2,8 @@
 //!
 //! The force gather, the update, saving the start positions and the divergence check are
 //! one pass over the particles: the method that benchmarks run streams each array once per
-//! step.
+//! step. The start positions are saved only for models with contact responses, the one
+//! reader that needs them exactly (see [`Workspace::start_positions`]).
 
 use super::Workspace;
 use crate::assembly::{Assembly, BLOCK, REDUCE_BLOCK};
@@ -12,16 +13,25 @@ use crate::particles::{Particles, Vec3};
 use crate::simulation::SANE_BOUND;
 
 pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) {
-    if model.gravity_only() {
-        update::<true>(model, p, dt, ws);
-    } else {
-        update::<false>(model, p, dt, ws);
+    let save = model.has_contact_responses();
+    ws.start_saved = save;
+    match (model.gravity_only(), save) {
+        (true, true) => update::<true, true>(model, p, dt, ws),
+        (true, false) => update::<true, false>(model, p, dt, ws),
+        (false, true) => update::<false, true>(model, p, dt, ws),
+        (false, false) => update::<false, false>(model, p, dt, ws),
     }
 }
 
 /// The step; with `GRAVITY_ONLY` (see [`Model::gravity_only`]) the external force is
-/// `m g`, without the general per-particle tests.
-fn update<const GRAVITY_ONLY: bool>(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) {
+/// `m g`, without the general per-particle tests; with `SAVE_START` the start positions
+/// go to `x0`.
+fn update<const GRAVITY_ONLY: bool, const SAVE_START: bool>(
+    model: &Model,
+    p: &mut Particles,
+    dt: f64,
+    ws: &mut Workspace,
+) {
     ws.assembly.scatter(&p.x, &p.v);
     let asm = &ws.assembly;
     let (mass, inv_mass) = (&p.mass, &p.inv_mass);
@@ -36,7 +46,9 @@ fn update<const GRAVITY_ONLY: bool>(model: &Model, p: &mut Particles, dt: f64, w
             asm.gather_block(start, springs);
             let (mass, inv_mass) = (&mass[start..start + n], &inv_mass[start..start + n]);
             for k in 0..n {
-                x0[k] = x[k];
+                if SAVE_START {
+                    x0[k] = x[k];
+                }
                 if inv_mass[k] == 0.0 {
                     continue;
                 }
