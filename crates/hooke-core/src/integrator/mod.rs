@@ -148,7 +148,9 @@ impl Workspace {
         self.implicit.iterations
     }
 
-    fn ensure(&mut self, model: &Model, particles: usize) {
+    /// Lays out `model`'s springs and sizes the buffers for `particles` particles, unless
+    /// they already fit: on the first step, or at once from [`crate::Simulation::new`].
+    pub(crate) fn ensure(&mut self, model: &Model, particles: usize) {
         let springs = model.springs.len();
         if !self.assembly.fits(particles, springs) {
             self.assembly = Assembly::new(particles, &model.springs);
