@@ -102,7 +102,55 @@ struct ClothFigures {
     seconds: f64,
     steps_per_s: f64,
     spring_updates_per_s: f64,
+    /// The median and the shortest of the steps' own times, and the rate at the median:
+    /// on a shared machine, where other work stalls some steps, these tell those stalls
+    /// from the solver's own speed.
+    median_step_s: f64,
+    fastest_step_s: f64,
+    median_spring_updates_per_s: f64,
     center_y: f64,
+}
+
+/// Step times of a timed run: the median and the shortest, over at most the first
+/// [`StepTimes::KEPT`] steps.
+struct StepTimes(Vec<f64>);
+
+impl StepTimes {
+    const KEPT: usize = 1 << 20;
+
+    /// Runs `steps` steps of `simulation`, timing each and calling `after` untimed after
+    /// each; returns the times and the total.
+    fn run(
+        simulation: &mut Simulation,
+        steps: u64,
+        mut after: impl FnMut(&Simulation),
+    ) -> Result<(Self, f64)> {
+        let mut times = Vec::with_capacity((steps as usize).min(Self::KEPT));
+        let started = Instant::now();
+        let mut last = started;
+        let mut untimed = std::time::Duration::ZERO;
+        for _ in 0..steps {
+            simulation.step()?;
+            let now = Instant::now();
+            after(simulation);
+            let resumed = Instant::now();
+            untimed += resumed - now;
+            if times.len() < Self::KEPT {
+                times.push((now - last).as_secs_f64());
+            }
+            last = resumed;
+        }
+        times.sort_by(f64::total_cmp);
+        Ok((Self(times), (last - started - untimed).as_secs_f64()))
+    }
+
+    fn median(&self) -> f64 {
+        self.0[self.0.len() / 2]
+    }
+
+    fn fastest(&self) -> f64 {
+        self.0[0]
+    }
 }
 
 #[derive(Serialize)]
@@ -119,6 +167,9 @@ struct SceneFigures {
     threads: usize,
     seconds: f64,
     steps_per_s: f64,
+    /// As in [`ClothFigures`].
+    median_step_s: f64,
+    fastest_step_s: f64,
 }
 
 #[derive(Serialize)]
@@ -231,9 +282,7 @@ fn cloth(
     warm.simulation.advance(steps.min(20))?;
     let mut scene = workload(n, steps, integrator)?;
     use_kernel(&mut scene.simulation, kernel)?;
-    let started = Instant::now();
-    scene.simulation.advance(steps)?;
-    let seconds = started.elapsed().as_secs_f64();
+    let (times, seconds) = StepTimes::run(&mut scene.simulation, steps, |_| ())?;
     let springs = scene.simulation.model().springs.len();
     let figures = ClothFigures {
         n,
@@ -245,6 +294,9 @@ fn cloth(
         seconds,
         steps_per_s: steps as f64 / seconds,
         spring_updates_per_s: (springs as u64 * steps) as f64 / seconds,
+        median_step_s: times.median(),
+        fastest_step_s: times.fastest(),
+        median_spring_updates_per_s: springs as f64 / times.median(),
         center_y: scene.simulation.particles().x[workload::centre(n)].y,
     };
     if json {
@@ -252,12 +304,16 @@ fn cloth(
     } else {
         println!(
             "cloth N={n}: {springs} springs, {steps} {integrator} steps on {} threads ({} \
-             kernel) in {:.3} s: {:.1} steps/s, {:.1} M spring updates/s; centre y = {:.12}",
+             kernel) in {:.3} s: {:.1} steps/s, {:.1} M spring updates/s; median step {:.3} \
+             ms ({:.1} M/s), fastest {:.3} ms; centre y = {:.12}",
             figures.threads,
             figures.kernel,
             seconds,
             figures.steps_per_s,
             figures.spring_updates_per_s / 1e6,
+            figures.median_step_s * 1e3,
+            figures.median_spring_updates_per_s / 1e6,
+            figures.fastest_step_s * 1e3,
             figures.center_y
         );
     }
@@ -278,13 +334,10 @@ fn scene_steps(
     let sim = &mut scene.simulation;
     use_kernel(sim, kernel)?;
     sim.advance(steps.min(100))?;
-    let started = Instant::now();
     let mut cg_iterations = 0;
-    for _ in 0..steps {
-        sim.step()?;
+    let (times, seconds) = StepTimes::run(sim, steps, |sim| {
         cg_iterations += sim.workspace().cg_iterations();
-    }
-    let seconds = started.elapsed().as_secs_f64();
+    })?;
     let figures = SceneFigures {
         cg_iterations_per_step: cg_iterations as f64 / steps as f64,
         dt: sim.dt(),
@@ -297,13 +350,16 @@ fn scene_steps(
         threads: rayon::current_num_threads(),
         seconds,
         steps_per_s: steps as f64 / seconds,
+        median_step_s: times.median(),
+        fastest_step_s: times.fastest(),
     };
     if json {
         println!("{}", serde_json::to_string(&figures)?);
     } else {
         println!(
             "{}: {} particles, {} springs, {steps} {} steps of {} s on {} threads ({} kernel) \
-             in {:.3} s: {:.0} steps/s, {:.3} s per simulated second{}",
+             in {:.3} s: {:.0} steps/s (median step {:.1} µs, fastest {:.1} µs), {:.3} s per \
+             simulated second{}",
             figures.scene,
             figures.particles,
             figures.springs,
@@ -313,6 +369,8 @@ fn scene_steps(
             figures.kernel,
             seconds,
             figures.steps_per_s,
+            figures.median_step_s * 1e6,
+            figures.fastest_step_s * 1e6,
             seconds / (steps as f64 * figures.dt),
             if cg_iterations > 0 {
                 format!(

@@ -383,3 +383,43 @@ fn run_writes_frame_pngs_and_a_gif_and_render_a_still() {
         (120, 90)
     );
 }
+
+/// `hooke bench cloth --json` prints the workload's figures as one object. Its centre
+/// particle, far from the pins with every spring at rest, falls as a free particle does
+/// under symplectic Euler, `g dt² n(n+1)/2` after `n` steps.
+#[test]
+fn bench_cloth_prints_the_workload_figures_as_json() {
+    let dir = scratch("bench");
+    let out = hooke(
+        &["bench", "cloth", "--n", "16", "--threads", "2", "--json"],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let figures: serde_json::Value = serde_json::from_str(text.trim()).unwrap();
+    let number = |key: &str| {
+        figures[key]
+            .as_f64()
+            .unwrap_or_else(|| panic!("no number '{key}' in {text}"))
+    };
+    assert_eq!(number("n"), 16.0);
+    assert_eq!(number("steps"), 200.0);
+    assert_eq!(number("threads"), 2.0);
+    // 2N(N-1) + 2(N-1)² + 2N(N-2) springs.
+    assert_eq!(
+        number("springs"),
+        (2 * 16 * 15 + 2 * 15 * 15 + 2 * 16 * 14) as f64
+    );
+    let seconds = number("seconds");
+    let rate = number("spring_updates_per_s");
+    assert!((rate * seconds / (number("springs") * 200.0) - 1.0).abs() < 1e-9);
+    assert!((number("steps_per_s") * seconds / 200.0 - 1.0).abs() < 1e-9);
+    assert!(number("fastest_step_s") <= number("median_step_s"));
+    assert!(number("median_step_s") <= seconds);
+    let drop = 1.0 - number("center_y");
+    let free_fall = 9.81 * 1e-5 * 1e-5 * (200.0 * 201.0 / 2.0);
+    assert!(
+        (drop / free_fall - 1.0).abs() < 1e-6,
+        "centre fell {drop:e} m, a free particle {free_fall:e} m"
+    );
+}
