@@ -13,7 +13,6 @@
 
 use crate::kernel::Kernel;
 use crate::model::Model;
-use crate::parallel;
 use crate::particles::Vec3;
 use crate::spring::{Lanes, Spring, spring_lanes};
 use rayon::prelude::*;
@@ -302,16 +301,12 @@ struct Partition {
 }
 
 /// Runs `f` on every partition: in parallel when there are several, inline for one (a small
-/// system, where a rayon call would cost more than the springs). Each partition is its own
-/// task on several threads (see [`parallel::task_len`]).
+/// system, where a rayon call would cost more than the springs).
 fn each_partition(partitions: &mut [Partition], f: impl Fn(&mut Partition) + Sync + Send) {
     if let [only] = partitions {
         f(only);
     } else {
-        partitions
-            .par_iter_mut()
-            .with_max_len(parallel::task_len())
-            .for_each(f);
+        partitions.par_iter_mut().for_each(f);
     }
 }
 

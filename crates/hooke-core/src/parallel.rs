@@ -16,25 +16,6 @@ pub(crate) fn on_worker<R: Send>(f: impl FnOnce() -> R + Send) -> R {
     }
 }
 
-/// The most items of a parallel loop over blocks or partitions that one task takes: one
-/// when there are threads to balance, no limit on a single thread (where splitting only
-/// costs: 2-3 % of a cloth-256 step, measured).
-///
-/// Rayon otherwise hands each thread runs of several items, split further only when
-/// another thread steals: a step's loop then ends with one thread idle for up to a run's
-/// length (measured on cloth-256, 2 threads: a median 51 µs at the end of the spring loop
-/// of 32 partitions). Idle that long, a rayon worker goes to sleep, and on a virtual
-/// machine waking it costs tens of microseconds more (a median 30 µs with both threads
-/// idle between loops). With one item per task the loops end within one item (17-20 µs)
-/// and the gap is 1-2 µs. The split never changes a result: items are independent.
-pub(crate) fn task_len() -> usize {
-    if rayon::current_num_threads() > 1 {
-        1
-    } else {
-        usize::MAX
-    }
-}
-
 /// Calls `f(start, a_block, b_block)` over matching blocks of `block` particles of two
 /// per-particle arrays: in parallel when there is more than one block, inline otherwise
 /// (a rayon call costs microseconds, too much for a 512-particle jelly stepped 10k times a
@@ -53,7 +34,6 @@ pub(crate) fn for_blocks(
     } else {
         a.par_chunks_mut(block)
             .zip(b.par_chunks_mut(block))
-            .with_max_len(task_len())
             .enumerate()
             .for_each(|(k, (a, b))| f(k * block, a, b));
     }
@@ -89,7 +69,6 @@ pub(crate) fn all_blocks3<C: Send>(
         a.par_chunks_mut(block)
             .zip(b.par_chunks_mut(block))
             .zip(c.par_chunks_mut(block))
-            .with_max_len(task_len())
             .enumerate()
             .map(|(k, ((a, b), c))| f(k * block, a, b, c))
             .reduce(|| true, |p, q| p & q)
@@ -162,7 +141,6 @@ pub(crate) fn for_each_in(
         out.iter_mut().enumerate().for_each(|(i, o)| f(i, o));
     } else {
         out.par_chunks_mut(block)
-            .with_max_len(task_len())
             .enumerate()
             .for_each(|(b, chunk)| {
                 for (k, o) in chunk.iter_mut().enumerate() {
