@@ -75,10 +75,10 @@ impl Prepared<'_> {
             let Some(s) = &self.tris[id] else {
                 return Surface::Flat([0.0; 3]);
             };
-            let t = &self.list.triangles[s.src as usize];
             if s.tiny {
-                return Surface::Lit((t.n[0] + t.n[1] + t.n[2]) * (1.0 / 3.0), t.color);
+                return Surface::Lit(s.normal, s.color);
             }
+            let t = &self.list.triangles[s.src as usize];
             let w = s.weights(p);
             Surface::Lit(t.n[0] * w[0] + t.n[1] * w[1] + t.n[2] * w[2], t.color)
         } else if id < nt + nl {

@@ -78,7 +78,7 @@ impl Samples {
         let Some(r) = self.clip(&t.rect) else {
             return;
         };
-        let [a, b, c] = t.v;
+        let [a, b, c] = t.corners();
         let bias = |p: [i64; 2], q: [i64; 2]| {
             let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
             if dy > 0 || (dy == 0 && dx < 0) { 0 } else { -1 }
