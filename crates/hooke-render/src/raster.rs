@@ -101,20 +101,45 @@ impl Prepared<'_> {
         [0, 1, 2].map(|c| top[c] * (1.0 - t) + bottom[c] * t)
     }
 
+    /// The first output pixel `(x, y)` of a tile of samples and its size in pixels.
+    fn pixels_of(&self, area: &Rect) -> ((u32, u32), (u32, u32)) {
+        let ss = self.ss;
+        let first = (area.x0 / ss, area.y0 / ss);
+        (first, ((area.x1 - area.x0) / ss, (area.y1 - area.y0) / ss))
+    }
+
+    /// The background of a tile that no primitive touches, row-major over the tile: what
+    /// [`Prepared::resolve`] gives for it, without clearing and reading its samples (most
+    /// tiles of a still where the subject fills a third of the frame).
+    fn background_tile(&self, area: &Rect, out: &mut Vec<u8>) {
+        let ((_, py0), (w, h)) = self.pixels_of(area);
+        out.clear();
+        out.resize((w * h * 4) as usize, 0);
+        for (y, pixels) in (0..h).zip(out.chunks_exact_mut((w * 4) as usize)) {
+            let pixel = rgba8(self.background(py0 + y));
+            for p in pixels.chunks_exact_mut(4) {
+                p.copy_from_slice(&pixel);
+            }
+        }
+    }
+
     /// Shades and averages the tile's samples into RGBA8 pixels, row-major over the tile.
     fn resolve(&self, s: &Samples, out: &mut Vec<u8>) {
         let ss = self.ss;
-        let (px0, py0) = (s.area.x0 / ss, s.area.y0 / ss);
-        let (w, h) = ((s.area.x1 - s.area.x0) / ss, (s.area.y1 - s.area.y0) / ss);
+        let ((px0, py0), (w, h)) = self.pixels_of(&s.area);
         let weight = 1.0 / (ss * ss) as f32;
         out.clear();
         out.resize((w * h * 4) as usize, 0);
-        // Distinct primitives of one pixel and their sample counts (at most 16 samples).
+        // Distinct primitives of one pixel and their sample counts (at most 16 samples), and
+        // its distinct lit materials: reused from pixel to pixel (only the first `distinct`
+        // or `materials` entries are read), as clearing 16 materials per edge pixel cost a
+        // tenth of a cloth-256 frame.
         let mut ids = [(0u32, 0u32); 16];
-        for y in 0..h {
+        let mut lit: [(Rgb, Vector3<f64>, u32); 16] = [([0.0; 3], Vector3::zeros(), 0); 16];
+        for (y, pixels) in (0..h).zip(out.chunks_exact_mut((w * 4) as usize)) {
             let background = self.background(py0 + y);
             let row = s.index(s.area.x0, s.area.y0 + y * ss);
-            for x in 0..w {
+            for (x, pixel) in (0..w).zip(pixels.chunks_exact_mut(4)) {
                 let first = row + (x * ss) as usize;
                 let mut distinct = 0;
                 for sy in 0..ss as usize {
@@ -145,8 +170,6 @@ impl Prepared<'_> {
                     // where a smooth mesh's triangles are pixel-sized, a pixel shades once
                     // per material rather than once per triangle, and looks the same.
                     let mut sum = [0.0f32; 3];
-                    let mut lit: [(Rgb, Vector3<f64>, u32); 16] =
-                        [([0.0; 3], Vector3::zeros(), 0); 16];
                     let mut materials = 0;
                     for &(id, count) in &ids[..distinct] {
                         let surface = if id == EMPTY {
@@ -182,15 +205,20 @@ impl Prepared<'_> {
                     }
                     sum.map(|v| v * weight)
                 };
-                let o = ((y * w + x) * 4) as usize;
-                for k in 0..3 {
-                    // Truncating `v + 0.5` rounds: `f32::round` is a libm call per channel.
-                    out[o + k] = (c[k].clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-                }
-                out[o + 3] = 255;
+                pixel.copy_from_slice(&rgba8(c));
             }
         }
     }
+}
+
+/// An opaque RGBA8 pixel of colour `c`, each channel clamped to `[0, 1]`.
+#[inline]
+fn rgba8(c: Rgb) -> [u8; 4] {
+    // Truncating `v + 0.5` rounds: `f32::round` is a libm call per channel. The value is
+    // in [0.5, 255.5] (or NaN, which gives 0 either way), so going through i32 skips the
+    // saturating u8 conversion's extra tests.
+    let channel = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as i32 as u8;
+    [channel(c[0]), channel(c[1]), channel(c[2]), 255]
 }
 
 /// Renders `list` seen by `camera` into an RGBA8 image of `width × height` pixels, row-major.
@@ -266,12 +294,18 @@ impl Renderer {
             || Samples::new(grid.side),
             |samples, (t, pixels)| {
                 let (tx, ty) = (t as u32 % grid.across, t as u32 / grid.across);
-                samples.reset(Rect {
+                let area = Rect {
                     x0: tx * grid.side,
                     y0: ty * grid.side,
                     x1: ((tx + 1) * grid.side).min(w),
                     y1: ((ty + 1) * grid.side).min(h),
-                });
+                };
+                let bins = [tri_bins, line_bins, point_bins];
+                if bins.iter().all(|b| b.tile(t).next().is_none()) {
+                    prepared.background_tile(&area, pixels);
+                    return;
+                }
+                samples.reset(area);
                 // Binned primitives are the set-up ones: the `if let` never skips.
                 for id in tri_bins.tile(t) {
                     if let Some(s) = &prepared.tris[id as usize] {
