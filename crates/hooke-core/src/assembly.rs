@@ -14,7 +14,7 @@
 use crate::kernel::Kernel;
 use crate::model::Model;
 use crate::particles::Vec3;
-use crate::spring::{Lanes, Spring, spring_lanes};
+use crate::spring::{Spring, SpringBatch};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::ops::Range;
@@ -219,56 +219,54 @@ impl SpringTable {
 }
 
 /// Springs per batch of the force loop.
-const LANES: usize = 64;
+pub(crate) const LANES: usize = 64;
 
 /// Adds the forces of the springs `ends`/`rest` into `force`, the window of particles from
 /// `lo`. With `UNIFORM`, every spring has stiffness and damping `params[0]`; otherwise
 /// spring `k` has `params[param[k]]`.
 ///
-/// Springs go in batches of [`LANES`], in three passes: load each spring's end
-/// differences into the batch's arrays, compute the batch's forces in one vectorised loop
-/// ([`spring_lanes`]), then add them to the ends. The middle pass is where the arithmetic
-/// is, and only there can the compiler run several springs per instruction; the outer
-/// passes move data between the particles' layout and the batch's.
+/// Springs go in batches of `B::LEN`, in three passes: load each spring's end
+/// differences into the batch, compute the batch's forces in one vectorised loop
+/// ([`SpringBatch::run`]), then add them to the ends. The middle pass is where the
+/// arithmetic is, and only there can the compiler run several springs per instruction; the
+/// outer passes move data between the particles' layout and the batch's.
 #[inline(always)]
-pub(crate) fn scatter_springs<const UNIFORM: bool, R: Rest>(
+pub(crate) fn scatter_springs<const UNIFORM: bool, R: Rest, B: SpringBatch>(
     ((ends, rest), (param, params), (lo, force), x, v): ScatterArgs<R>,
 ) {
     // Equal lengths let one bounds check on `x` cover `v` too.
     let v = &v[..x.len()];
-    let mut lanes = Lanes::<LANES>::default();
+    let mut batch = B::default();
     if UNIFORM {
         let [ks, kd] = params[0];
-        lanes.ks = [ks; LANES];
-        lanes.kd = [kd; LANES];
+        batch.set_all_params(ks, kd);
     }
-    let mut f = [[0.0; 3]; LANES];
     // Springs sharing a lower end are consecutive: sum their pull on it in a register and
     // store once, instead of a store-to-load chain through memory per spring.
     let mut current = lo;
     let mut pull = Vec3::zeros();
     let (mut lower, mut xi, mut vi) = (usize::MAX, Vec3::zeros(), Vec3::zeros());
-    for (b, ends) in ends.chunks(LANES).enumerate() {
-        let n = ends.len().min(LANES);
-        let rest = rest.slice(b * LANES..b * LANES + n);
-        for l in 0..n {
-            let [i, j] = ends[l];
+    for (b, ends) in ends.chunks(B::LEN).enumerate() {
+        // `n <= B::LEN` is what lets the compiler drop the batch's bounds checks.
+        let n = ends.len().min(B::LEN);
+        let rest = rest.slice(b * B::LEN..b * B::LEN + n);
+        for (l, &[i, j]) in ends[..n].iter().enumerate() {
             let (i, j) = (i as usize, j as usize);
             // Consecutive springs mostly share their lower end: load it once per run.
             if i != lower {
                 lower = i;
                 (xi, vi) = (x[i], v[i]);
             }
-            lanes.set(l, (&(xi - x[j]), &(vi - v[j])), rest.rest(l));
+            batch.set(l, &(xi - x[j]), &(vi - v[j]), rest.rest(l));
             if !UNIFORM {
-                [lanes.ks[l], lanes.kd[l]] = params[param[b * LANES + l] as usize];
+                let [ks, kd] = params[param[b * B::LEN + l] as usize];
+                batch.set_params(l, ks, kd);
             }
         }
-        spring_lanes(&lanes, n, &mut f);
-        for l in 0..n {
-            let [i, j] = ends[l];
+        batch.run(n);
+        for (l, &[i, j]) in ends[..n].iter().enumerate() {
             let (i, j) = (i as usize, j as usize);
-            let f = Vec3::from(f[l]);
+            let f = batch.force(l);
             if i != current {
                 force[current - lo] += pull;
                 pull = Vec3::zeros();

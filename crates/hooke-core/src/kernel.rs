@@ -4,10 +4,13 @@
 //! division per spring, whose throughput per instruction is the same for 1, 2, 4 or 8
 //! lanes on current x86 cores: wider vectors are nearly free speed. Portable builds target
 //! baseline x86-64 (2 lanes), so the loop is compiled again for AVX2 and AVX-512 and the
-//! widest the CPU supports is picked at run time. This is the workspace's one use of
-//! `unsafe`: calling a function compiled for features that were checked to be present.
+//! widest the CPU supports is picked at run time, each with the batch layout it runs
+//! fastest with (`ComponentBatch` or `VectorBatch`, see `spring.rs`). This is the
+//! workspace's one use of `unsafe`: calling a function compiled for features that were
+//! checked to be present.
 
-use crate::assembly::{Rest, ScatterArgs, scatter_springs};
+use crate::assembly::{LANES, Rest, ScatterArgs, scatter_springs};
+use crate::spring::{ComponentBatch, VectorBatch};
 use std::fmt;
 use std::str::FromStr;
 
@@ -77,7 +80,7 @@ impl Kernel {
     #[allow(unsafe_code)]
     pub(crate) fn scatter<const UNIFORM: bool, R: Rest>(self, args: ScatterArgs<R>) {
         match self {
-            Self::Portable => scatter_springs::<UNIFORM, R>(args),
+            Self::Portable => scatter_springs::<UNIFORM, R, ComponentBatch<LANES>>(args),
             // SAFETY: a kernel other than `Portable` comes from `detect`, which checked that
             // the CPU has the features these functions are compiled for.
             #[cfg(target_arch = "x86_64")]
@@ -85,7 +88,7 @@ impl Kernel {
             #[cfg(target_arch = "x86_64")]
             Self::Avx512 => unsafe { scatter_avx512::<UNIFORM, R>(args) },
             #[cfg(not(target_arch = "x86_64"))]
-            _ => scatter_springs::<UNIFORM, R>(args),
+            _ => scatter_springs::<UNIFORM, R, ComponentBatch<LANES>>(args),
         }
     }
 }
@@ -116,14 +119,14 @@ impl FromStr for Kernel {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn scatter_avx2<const UNIFORM: bool, R: Rest>(args: ScatterArgs<R>) {
-    scatter_springs::<UNIFORM, R>(args);
+    scatter_springs::<UNIFORM, R, ComponentBatch<LANES>>(args);
 }
 
 /// The spring force loop compiled for AVX-512.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
 fn scatter_avx512<const UNIFORM: bool, R: Rest>(args: ScatterArgs<R>) {
-    scatter_springs::<UNIFORM, R>(args);
+    scatter_springs::<UNIFORM, R, VectorBatch<LANES>>(args);
 }
 
 #[cfg(test)]
