@@ -453,7 +453,7 @@ fn renders(
         }
         let figures = RenderFigures {
             scene: name.clone(),
-            triangles: list.triangles.len(),
+            triangles: list.triangle_count(),
             width,
             height,
             samples_per_pixel: options.supersample * options.supersample,

@@ -1,7 +1,7 @@
 //! Turning a scene's particles, springs and colliders into a draw list for the rasterizer.
 
 use hooke_core::{SpringKind, Vec3};
-use hooke_render::{Camera, DrawList, Line, Point, Rgb};
+use hooke_render::{Camera, DrawList, Line, Mesh, Point, Rgb};
 use hooke_scene::{ColliderGeometry, Scene, Topology};
 
 /// What to draw of the bodies.
@@ -38,7 +38,8 @@ fn spring_color(kind: SpringKind) -> Rgb {
     }
 }
 
-/// Adds a `rows × cols` sheet of particles (`index(r, c)`) as smooth-shaded triangles.
+/// Adds a `rows × cols` sheet of particles (`index(r, c)`) as a smooth-shaded mesh, two
+/// triangles per grid square.
 fn sheet(
     list: &mut DrawList,
     x: &[Vec3],
@@ -50,8 +51,11 @@ fn sheet(
     if rows < 2 || cols < 2 {
         return;
     }
+    let positions: Vec<Vec3> = (0..rows * cols)
+        .map(|k| x[index(k / cols, k % cols)])
+        .collect();
+    let at = |r: usize, c: usize| positions[r * cols + c];
     let mut normals = vec![Vec3::zeros(); rows * cols];
-    let at = |r: usize, c: usize| x[index(r, c)];
     for r in 0..rows - 1 {
         for c in 0..cols - 1 {
             let n = (at(r + 1, c) - at(r, c)).cross(&(at(r, c + 1) - at(r, c)));
@@ -60,25 +64,23 @@ fn sheet(
             }
         }
     }
-    let normal = |r: usize, c: usize| {
-        normals[r * cols + c]
-            .try_normalize(1e-18)
-            .unwrap_or(Vec3::y())
-    };
+    for n in &mut normals {
+        *n = n.try_normalize(1e-18).unwrap_or(Vec3::y());
+    }
+    let corner = |r: usize, c: usize| (r * cols + c) as u32;
+    let mut triangles = Vec::with_capacity(2 * (rows - 1) * (cols - 1));
     for r in 0..rows - 1 {
         for c in 0..cols - 1 {
-            for tri in [
-                [(r, c), (r + 1, c), (r + 1, c + 1)],
-                [(r, c), (r + 1, c + 1), (r, c + 1)],
-            ] {
-                list.triangles.push(hooke_render::Triangle {
-                    p: tri.map(|(a, b)| at(a, b)),
-                    n: tri.map(|(a, b)| normal(a, b)),
-                    color,
-                });
-            }
+            triangles.push([corner(r, c), corner(r + 1, c), corner(r + 1, c + 1)]);
+            triangles.push([corner(r, c), corner(r + 1, c + 1), corner(r, c + 1)]);
         }
     }
+    list.meshes.push(Mesh {
+        positions,
+        normals,
+        triangles,
+        color,
+    });
 }
 
 fn ground(list: &mut DrawList, height: f64, centre: Vec3, half: f64) {

@@ -61,26 +61,22 @@ pub(crate) struct Bins {
 }
 
 impl Bins {
-    /// Bins `items` (`None` for primitives that were culled) into the tiles of `grid`.
-    pub fn fill<T: Sync>(
-        &mut self,
-        items: &[Option<T>],
-        rect: impl Fn(&T) -> Rect + Sync,
-        grid: &Grid,
-    ) {
+    /// Bins primitives by their sample rectangles (`None` for primitives that were culled)
+    /// into the tiles of `grid`.
+    pub fn fill(&mut self, rects: &[Option<Rect>], grid: &Grid) {
         let tiles = grid.count();
         self.chunks
-            .resize_with(items.len().div_ceil(CHUNK), Chunk::default);
+            .resize_with(rects.len().div_ceil(CHUNK), Chunk::default);
         self.chunks
             .par_iter_mut()
-            .zip(items.par_chunks(CHUNK))
+            .zip(rects.par_chunks(CHUNK))
             .enumerate()
             .for_each(|(c, (bin, chunk))| {
                 let start = &mut bin.start;
                 start.clear();
                 start.resize(tiles + 1, 0);
-                let spans = chunk.iter().enumerate().filter_map(|(k, item)| {
-                    Some(((c * CHUNK + k) as u32, grid.span(&rect(item.as_ref()?))))
+                let spans = chunk.iter().enumerate().filter_map(|(k, rect)| {
+                    Some(((c * CHUNK + k) as u32, grid.span(rect.as_ref()?)))
                 });
                 for (_, (x0, y0, x1, y1)) in spans.clone() {
                     for ty in y0..=y1 {

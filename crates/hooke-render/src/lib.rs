@@ -1,6 +1,6 @@
 //! # hooke-render: a small CPU rasterizer
 //!
-//! World-space triangles, lines and points plus a [`Camera`] in, RGBA pixels out. No
+//! World-space meshes, triangles, lines and points plus a [`Camera`] in, RGBA pixels out. No
 //! physics, no files: the CLI turns particles, springs and colliders into a [`DrawList`] and
 //! encodes the pixels. Two-sided Lambert + ambient + a little specular lighting, a z-buffer,
 //! 4× supersampling by default, tiles rendered in parallel with one writer per pixel,
@@ -29,5 +29,5 @@ mod shading;
 mod tile;
 
 pub use camera::Camera;
-pub use draw_list::{DrawList, Line, Point, Rgb, Triangle};
+pub use draw_list::{DrawList, Line, Mesh, Point, Rgb, Triangle};
 pub use raster::{RenderOptions, Renderer, render};

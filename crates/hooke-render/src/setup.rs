@@ -24,7 +24,7 @@ pub(crate) struct Rect {
 
 /// A point in sample space: x right, y down, in samples; `z` is NDC depth.
 #[derive(Clone, Copy, Debug)]
-struct Projected {
+pub(crate) struct Projected {
     x: f64,
     y: f64,
     z: f64,
@@ -50,7 +50,7 @@ impl Frame {
     }
 
     /// `None` when the point is closer than the near plane (or behind the eye).
-    fn project(&self, p: &Vector3<f64>) -> Option<Projected> {
+    pub fn project(&self, p: &Vector3<f64>) -> Option<Projected> {
         let c = self.m * Vector4::new(p.x, p.y, p.z, 1.0);
         if c.w.is_nan() || c.w < self.near {
             return None;
@@ -141,6 +141,19 @@ impl TriSetup {
             frame.project(&t.p[1])?,
             frame.project(&t.p[2])?,
         ];
+        Self::projected(frame, p, &t.n, t.color, src)
+    }
+
+    /// A triangle from its corners already projected (a mesh's, projected once per frame)
+    /// and its corner normals `n`.
+    #[inline]
+    pub fn projected(
+        frame: &Frame,
+        p: [Projected; 3],
+        n: &[Vector3<f64>; 3],
+        color: Rgb,
+        src: u32,
+    ) -> Option<Self> {
         if p.iter().any(|q| q.x.abs() > GUARD || q.y.abs() > GUARD) {
             return None;
         }
@@ -163,9 +176,10 @@ impl TriSetup {
             inv_w.swap(1, 2);
             area = -area;
         }
+        // Written out: as iterator folds these were left uninlined, a fifth of set-up.
         let (min, max) = (
-            [0, 1].map(|a| v.iter().map(|c| c[a]).min().unwrap_or(0)),
-            [0, 1].map(|a| v.iter().map(|c| c[a]).max().unwrap_or(0)),
+            [0, 1].map(|a| v[0][a].min(v[1][a]).min(v[2][a])),
+            [0, 1].map(|a| v[0][a].max(v[1][a]).max(v[2][a])),
         );
         let rect = frame.fixed_rect(min, max)?;
         Some(Self {
@@ -178,8 +192,8 @@ impl TriSetup {
             swapped,
             tiny: rect.x1 - rect.x0 <= 2 && rect.y1 - rect.y0 <= 2,
             rect,
-            normal: (t.n[0] + t.n[1] + t.n[2]) * (1.0 / 3.0),
-            color: t.color,
+            normal: (n[0] + n[1] + n[2]) * (1.0 / 3.0),
+            color,
         })
     }
 
