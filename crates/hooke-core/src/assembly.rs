@@ -225,13 +225,13 @@ pub(crate) const LANES: usize = 64;
 /// `lo`. With `UNIFORM`, every spring has stiffness and damping `params[0]`; otherwise
 /// spring `k` has `params[param[k]]`.
 ///
-/// Springs go in batches of `B::LEN`, in three passes: load each spring's end
+/// Springs go in batches of [`LANES`], in three passes: load each spring's end
 /// differences into the batch, compute the batch's forces in one vectorised loop
 /// ([`SpringBatch::run`]), then add them to the ends. The middle pass is where the
 /// arithmetic is, and only there can the compiler run several springs per instruction; the
 /// outer passes move data between the particles' layout and the batch's.
 #[inline(always)]
-pub(crate) fn scatter_springs<const UNIFORM: bool, R: Rest, B: SpringBatch>(
+pub(crate) fn scatter_springs<const UNIFORM: bool, R: Rest, B: SpringBatch<LANES>>(
     ((ends, rest), (param, params), (lo, force), x, v): ScatterArgs<R>,
 ) {
     // Equal lengths let one bounds check on `x` cover `v` too.
@@ -246,10 +246,10 @@ pub(crate) fn scatter_springs<const UNIFORM: bool, R: Rest, B: SpringBatch>(
     let mut current = lo;
     let mut pull = Vec3::zeros();
     let (mut lower, mut xi, mut vi) = (usize::MAX, Vec3::zeros(), Vec3::zeros());
-    for (b, ends) in ends.chunks(B::LEN).enumerate() {
-        // `n <= B::LEN` is what lets the compiler drop the batch's bounds checks.
-        let n = ends.len().min(B::LEN);
-        let rest = rest.slice(b * B::LEN..b * B::LEN + n);
+    for (b, ends) in ends.chunks(LANES).enumerate() {
+        // `n <= LANES` is what lets the compiler drop the batch's bounds checks.
+        let n = ends.len().min(LANES);
+        let rest = rest.slice(b * LANES..b * LANES + n);
         for (l, &[i, j]) in ends[..n].iter().enumerate() {
             let (i, j) = (i as usize, j as usize);
             // Consecutive springs mostly share their lower end: load it once per run.
@@ -259,7 +259,7 @@ pub(crate) fn scatter_springs<const UNIFORM: bool, R: Rest, B: SpringBatch>(
             }
             batch.set(l, &(xi - x[j]), &(vi - v[j]), rest.rest(l));
             if !UNIFORM {
-                let [ks, kd] = params[param[b * B::LEN + l] as usize];
+                let [ks, kd] = params[param[b * LANES + l] as usize];
                 batch.set_params(l, ks, kd);
             }
         }

@@ -109,24 +109,58 @@ fn spring_formula(d: [f64; 3], dv: [f64; 3], rest: f64, ks: f64, kd: f64) -> [f6
     [ux * scale, uy * scale, uz * scale]
 }
 
-/// A batch of springs for the force loop: each spring's end differences, rest length,
+/// A batch of `L` springs for the force loop: each spring's end differences, rest length,
 /// stiffness and damping go in, [`SpringBatch::run`] computes all their forces in one
-/// vectorised loop, and each force comes out. The layout in between is the implementation's:
-/// which one is faster depends on the instruction set (see [`ComponentBatch`] and
-/// [`VectorBatch`]), never the result.
-pub(crate) trait SpringBatch: Default {
-    /// Springs per batch.
-    const LEN: usize;
-    /// Sets spring `l`'s end differences and rest length.
-    fn set(&mut self, l: usize, d: &Vec3, dv: &Vec3, rest: f64);
-    /// Sets spring `l`'s stiffness and damping.
-    fn set_params(&mut self, l: usize, ks: f64, kd: f64);
-    /// Sets every spring's stiffness and damping.
-    fn set_all_params(&mut self, ks: f64, kd: f64);
+/// vectorised loop, and each force comes out. The vectors' layout in between is the
+/// implementation's: which one is faster depends on the instruction set (see
+/// [`ComponentBatch`] and [`VectorBatch`]), never the result.
+pub(crate) trait SpringBatch<const L: usize>: Default {
+    /// The batch's rest lengths, stiffnesses and dampings.
+    fn scalars(&mut self) -> &mut BatchScalars<L>;
+    /// Sets spring `l`'s end differences.
+    fn set_vectors(&mut self, l: usize, d: &Vec3, dv: &Vec3);
     /// Computes the forces of the first `n` springs.
     fn run(&mut self, n: usize);
     /// The force on the `i` end of spring `l`, after [`SpringBatch::run`].
     fn force(&self, l: usize) -> Vec3;
+
+    /// Sets spring `l`'s end differences and rest length.
+    #[inline(always)]
+    fn set(&mut self, l: usize, d: &Vec3, dv: &Vec3, rest: f64) {
+        self.set_vectors(l, d, dv);
+        self.scalars().rest[l] = rest;
+    }
+
+    /// Sets spring `l`'s stiffness and damping.
+    #[inline(always)]
+    fn set_params(&mut self, l: usize, ks: f64, kd: f64) {
+        let s = self.scalars();
+        (s.ks[l], s.kd[l]) = (ks, kd);
+    }
+
+    /// Sets every spring's stiffness and damping.
+    fn set_all_params(&mut self, ks: f64, kd: f64) {
+        let s = self.scalars();
+        (s.ks, s.kd) = ([ks; L], [kd; L]);
+    }
+}
+
+/// The per-spring scalars of a batch, the same in every layout.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BatchScalars<const L: usize> {
+    rest: [f64; L],
+    ks: [f64; L],
+    kd: [f64; L],
+}
+
+impl<const L: usize> Default for BatchScalars<L> {
+    fn default() -> Self {
+        Self {
+            rest: [0.0; L],
+            ks: [0.0; L],
+            kd: [0.0; L],
+        }
+    }
 }
 
 /// `L` springs with each vector stored by component (`d[0]` holds every spring's x): the
@@ -138,9 +172,7 @@ pub(crate) trait SpringBatch: Default {
 pub(crate) struct ComponentBatch<const L: usize> {
     d: [[f64; L]; 3],
     dv: [[f64; L]; 3],
-    rest: [f64; L],
-    ks: [f64; L],
-    kd: [f64; L],
+    s: BatchScalars<L>,
     f: [[f64; L]; 3],
 }
 
@@ -149,33 +181,23 @@ impl<const L: usize> Default for ComponentBatch<L> {
         Self {
             d: [[0.0; L]; 3],
             dv: [[0.0; L]; 3],
-            rest: [0.0; L],
-            ks: [0.0; L],
-            kd: [0.0; L],
+            s: BatchScalars::default(),
             f: [[0.0; L]; 3],
         }
     }
 }
 
-impl<const L: usize> SpringBatch for ComponentBatch<L> {
-    const LEN: usize = L;
+impl<const L: usize> SpringBatch<L> for ComponentBatch<L> {
+    fn scalars(&mut self) -> &mut BatchScalars<L> {
+        &mut self.s
+    }
 
     #[inline(always)]
-    fn set(&mut self, l: usize, d: &Vec3, dv: &Vec3, rest: f64) {
+    fn set_vectors(&mut self, l: usize, d: &Vec3, dv: &Vec3) {
         for c in 0..3 {
             self.d[c][l] = d[c];
             self.dv[c][l] = dv[c];
         }
-        self.rest[l] = rest;
-    }
-
-    #[inline(always)]
-    fn set_params(&mut self, l: usize, ks: f64, kd: f64) {
-        (self.ks[l], self.kd[l]) = (ks, kd);
-    }
-
-    fn set_all_params(&mut self, ks: f64, kd: f64) {
-        (self.ks, self.kd) = ([ks; L], [kd; L]);
     }
 
     #[inline(always)]
@@ -188,9 +210,9 @@ impl<const L: usize> SpringBatch for ComponentBatch<L> {
             let f = spring_formula(
                 [d[0][l], d[1][l], d[2][l]],
                 [dv[0][l], dv[1][l], dv[2][l]],
-                self.rest[l],
-                self.ks[l],
-                self.kd[l],
+                self.s.rest[l],
+                self.s.ks[l],
+                self.s.kd[l],
             );
             for c in 0..3 {
                 self.f[c][l] = f[c];
@@ -213,9 +235,7 @@ impl<const L: usize> SpringBatch for ComponentBatch<L> {
 pub(crate) struct VectorBatch<const L: usize> {
     d: [[f64; 3]; L],
     dv: [[f64; 3]; L],
-    rest: [f64; L],
-    ks: [f64; L],
-    kd: [f64; L],
+    s: BatchScalars<L>,
     f: [[f64; 3]; L],
 }
 
@@ -224,38 +244,29 @@ impl<const L: usize> Default for VectorBatch<L> {
         Self {
             d: [[0.0; 3]; L],
             dv: [[0.0; 3]; L],
-            rest: [0.0; L],
-            ks: [0.0; L],
-            kd: [0.0; L],
+            s: BatchScalars::default(),
             f: [[0.0; 3]; L],
         }
     }
 }
 
-impl<const L: usize> SpringBatch for VectorBatch<L> {
-    const LEN: usize = L;
+impl<const L: usize> SpringBatch<L> for VectorBatch<L> {
+    fn scalars(&mut self) -> &mut BatchScalars<L> {
+        &mut self.s
+    }
 
     #[inline(always)]
-    fn set(&mut self, l: usize, d: &Vec3, dv: &Vec3, rest: f64) {
+    fn set_vectors(&mut self, l: usize, d: &Vec3, dv: &Vec3) {
         self.d[l] = [d.x, d.y, d.z];
         self.dv[l] = [dv.x, dv.y, dv.z];
-        self.rest[l] = rest;
-    }
-
-    #[inline(always)]
-    fn set_params(&mut self, l: usize, ks: f64, kd: f64) {
-        (self.ks[l], self.kd[l]) = (ks, kd);
-    }
-
-    fn set_all_params(&mut self, ks: f64, kd: f64) {
-        (self.ks, self.kd) = ([ks; L], [kd; L]);
     }
 
     #[inline(always)]
     fn run(&mut self, n: usize) {
         #[allow(clippy::needless_range_loop)]
         for l in 0..n.min(L) {
-            self.f[l] = spring_formula(self.d[l], self.dv[l], self.rest[l], self.ks[l], self.kd[l]);
+            let s = &self.s;
+            self.f[l] = spring_formula(self.d[l], self.dv[l], s.rest[l], s.ks[l], s.kd[l]);
         }
     }
 
@@ -269,11 +280,11 @@ impl<const L: usize> SpringBatch for VectorBatch<L> {
 mod tests {
     use super::*;
 
-    /// Runs `count` springs through a batch of layout `B`, `B::LEN` at a time (the last
+    /// Runs `count` springs through a batch of layout `B`, `L` at a time (the last
     /// batch partly filled), and returns their forces.
-    fn through<B: SpringBatch>(springs: &[(Vec3, Vec3, [f64; 3])]) -> Vec<Vec3> {
+    fn through<const L: usize, B: SpringBatch<L>>(springs: &[(Vec3, Vec3, [f64; 3])]) -> Vec<Vec3> {
         let mut out = Vec::new();
-        for chunk in springs.chunks(B::LEN) {
+        for chunk in springs.chunks(L) {
             let mut batch = B::default();
             for (l, (d, dv, [rest, ks, kd])) in chunk.iter().enumerate() {
                 batch.set(l, d, dv, *rest);
@@ -323,14 +334,20 @@ mod tests {
                 .collect()
         };
         assert_eq!(
-            bits(&through::<ComponentBatch<64>>(&springs)),
+            bits(&through::<64, ComponentBatch<64>>(&springs)),
             bits(&formula)
         );
         assert_eq!(
-            bits(&through::<ComponentBatch<4>>(&springs)),
+            bits(&through::<4, ComponentBatch<4>>(&springs)),
             bits(&formula)
         );
-        assert_eq!(bits(&through::<VectorBatch<64>>(&springs)), bits(&formula));
-        assert_eq!(bits(&through::<VectorBatch<8>>(&springs)), bits(&formula));
+        assert_eq!(
+            bits(&through::<64, VectorBatch<64>>(&springs)),
+            bits(&formula)
+        );
+        assert_eq!(
+            bits(&through::<8, VectorBatch<8>>(&springs)),
+            bits(&formula)
+        );
     }
 }
