@@ -112,7 +112,7 @@ pub(crate) struct TriSetup {
     pub inv_w: [f32; 3],
     /// Twice the signed area in fixed units squared, positive.
     pub area: i64,
-    /// Index in the draw list.
+    /// Index among the frame's triangles: the meshes' in order, then the list's own.
     pub src: u32,
     /// Whether corners 1 and 2 were exchanged to make the area positive.
     pub swapped: bool,
