@@ -28,6 +28,16 @@ static double now(void) {
     return t.tv_sec + 1e-9 * t.tv_nsec;
 }
 
+/* The workload's start: particle i*n + j at (i h, 1, j h), at rest. */
+static void place(double *x, double *v, int n, double h) {
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) {
+            double *p = x + 3 * (i * n + j);
+            p[0] = i * h, p[1] = 1.0, p[2] = j * h;
+        }
+    memset(v, 0, sizeof(double) * 3 * (size_t)n * n);
+}
+
 static int cmp_double(const void *a, const void *b) {
     double x = *(const double *)a, y = *(const double *)b;
     return (x > y) - (x < y);
@@ -43,12 +53,8 @@ int main(int argc, char **argv) {
     const int np = n * n;
     const double h = 1.0 / (n - 1), ks = 1000.0, kd = 0.01, dt = 1e-5, g = -9.81;
     const double m = 1.0 / np;
-    double *x = malloc(sizeof(double) * 3 * np), *v = calloc(3 * (size_t)np, sizeof(double));
-    for (int i = 0; i < n; i++)
-        for (int j = 0; j < n; j++) {
-            double *p = x + 3 * (i * n + j);
-            p[0] = i * h, p[1] = 1.0, p[2] = j * h;
-        }
+    double *x = malloc(sizeof(double) * 3 * np), *v = malloc(sizeof(double) * 3 * np);
+    place(x, v, n, h);
     const long ns = 2L * n * (n - 1) + 2L * (n - 1) * (n - 1) + 2L * n * (n - 2);
     Spring *s = malloc(sizeof(Spring) * ns);
     long k = 0;
@@ -80,12 +86,7 @@ int main(int argc, char **argv) {
         /* phase 0: warm-up on the same state, then reset; phase 1: measured. */
         int count = phase == 0 ? 20 : steps;
         if (phase == 1) {
-            for (int i = 0; i < n; i++)
-                for (int j = 0; j < n; j++) {
-                    double *p = x + 3 * (i * n + j);
-                    p[0] = i * h, p[1] = 1.0, p[2] = j * h;
-                }
-            memset(v, 0, sizeof(double) * 3 * np);
+            place(x, v, n, h);
             t0 = now();
         }
         for (int it = 0; it < count; it++) {
