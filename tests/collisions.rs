@@ -120,6 +120,9 @@ fn the_obj_table_agrees_with_the_analytic_cylinder() {
 fn no_cloth_particle_ends_up_inside_the_table_top() {
     let mut scene = builtin("cloth-table", &Overrides::default());
     let top = analytic_top();
+    // Resting particles lie a contact thickness above the top (those wrapping the rim up to
+    // a millimetre more).
+    let rest = round::TOP_Y + scene.bodies[0].thickness;
     let mut on_top = 0;
     for frame in 0..scene.steps / scene.every {
         scene.simulation.advance(scene.every).unwrap();
@@ -139,7 +142,7 @@ fn no_cloth_particle_ends_up_inside_the_table_top() {
             .particles()
             .x
             .iter()
-            .filter(|x| (x.y - round::TOP_Y).abs() < 1e-6)
+            .filter(|x| (x.y - rest).abs() < 1e-3)
             .count();
     }
     // The middle of the cloth lies on the top: about π R² / h² = 420 particles.
@@ -172,14 +175,16 @@ fn the_analytic_cylinder_table_gives_the_same_drape() {
         scene.simulation.particles().x.clone()
     };
     let (mesh, cylinder) = (run(None), run(Some("cylinder")));
-    let stuck = |x: &[Vec3]| {
-        x.iter()
-            .filter(|p| (p.y - round::TOP_Y).abs() < 1e-6)
-            .count()
-    };
+    let rest = round::TOP_Y + hooke_core::DEFAULT_CLOTH_THICKNESS;
+    // Within a millimetre: near the rim the cloth wraps the edge and lifts a little.
+    let stuck = |x: &[Vec3]| x.iter().filter(|p| (p.y - rest).abs() < 1e-3).count();
     let (a, b) = (stuck(&mesh), stuck(&cylinder));
+    assert!(a > 250, "only {a} particles rest on the mesh top");
+    // The mesh's rim is a 64-gon up to 0.72 mm inside the circle, and the cloth wraps a
+    // polygon's edges where it wraps the circle: the ring of particles at the rim may differ
+    // by a few percent (measured: 277 against 268).
     assert!(
-        a.abs_diff(b) <= 8,
+        a.abs_diff(b) <= a / 25,
         "particles on the top: mesh {a}, cylinder {b}"
     );
 }
@@ -198,10 +203,11 @@ fn cloth_table_runs_on_a_swapped_square_table() {
     scene.simulation.advance(scene.steps).unwrap();
     let top = hooke_collide::table::square::TOP_Y;
     let half = hooke_collide::table::square::HALF_SIDE;
+    let h = scene.bodies[0].thickness;
     let x = &scene.simulation.particles().x;
     let on_top = x
         .iter()
-        .filter(|p| (p.y - top).abs() < 1e-6 && p.x.abs() < half && p.z.abs() < half)
+        .filter(|p| (p.y - (top + h)).abs() < 1e-6 && p.x.abs() < half && p.z.abs() < half)
         .count();
     // A 1 m square top holds 400 particles of the cloth; sticking stops them sliding, so the
     // cloth landing last buckles into folds about 2 cm high and 184 touch the top.
@@ -211,7 +217,7 @@ fn cloth_table_runs_on_a_swapped_square_table() {
     );
     let at_round_height = x
         .iter()
-        .filter(|p| (p.y - round::TOP_Y).abs() < 1e-6)
+        .filter(|p| (p.y - (round::TOP_Y + h)).abs() < 1e-6)
         .count();
     assert_eq!(
         at_round_height, 0,
@@ -254,7 +260,7 @@ fn implicit_cloth_stays_on_the_table_at_twenty_times_the_symplectic_step() {
     let x = &scene.simulation.particles().x;
     let on_top = x
         .iter()
-        .filter(|p| (p.x * p.x + p.z * p.z).sqrt() < 0.6 && (0.999..1.01).contains(&p.y))
+        .filter(|p| (p.x * p.x + p.z * p.z).sqrt() < 0.6 && (1.004..1.015).contains(&p.y))
         .count();
     assert!(on_top > 200, "only {on_top} particles rest on the top");
     let inside = x

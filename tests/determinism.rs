@@ -57,6 +57,24 @@ fn cloth_table_contacts_are_bit_identical_on_one_and_two_threads() {
     assert_eq!(run(1), run(2));
 }
 
+/// A cloth folding onto itself: self-collision candidates, proximities and their
+/// Gauss–Seidel projections run in one fixed order, whatever the thread count.
+#[test]
+fn cloth_pile_self_contacts_are_bit_identical_on_one_two_and_three_threads() {
+    let run = |threads| {
+        on_threads(threads, || {
+            let mut scene = builtin("cloth-pile", &Overrides::default());
+            // 0.75 s: the cloth has buckled and its folds touch.
+            scene.simulation.advance(3000).unwrap();
+            assert!(scene.simulation.workspace().contact_stats().proximities > 0);
+            state(&scene)
+        })
+    };
+    let one = run(1);
+    assert_eq!(one, run(2), "1 vs 2 threads");
+    assert_eq!(one, run(3), "1 vs 3 threads");
+}
+
 /// The force loop's compilations for wider vector units (AVX2, AVX-512) give the portable
 /// build's bits: on the cloth workload and on the cloth-table scene, whose springs have
 /// several stiffnesses. Only the kernels this CPU runs are compared.

@@ -6,6 +6,7 @@
 mod collisions;
 mod common;
 mod conservation;
+mod contact;
 mod determinism;
 mod images;
 mod oscillator;

@@ -170,6 +170,11 @@ struct SceneFigures {
     /// As in [`ClothFigures`].
     median_step_s: f64,
     fastest_step_s: f64,
+    /// The contact phase's share of the measured wall time (collider faces, features and
+    /// self-collision), 0 to 1.
+    contact_share: f64,
+    /// Rebuilds of the contact candidate lists during the measured steps.
+    contact_rebuilds: u64,
 }
 
 #[derive(Serialize)]
@@ -335,9 +340,11 @@ fn scene_steps(
     use_kernel(sim, kernel)?;
     sim.advance(steps.min(100))?;
     let mut cg_iterations = 0;
+    let contacts_before = sim.workspace().contact_stats();
     let (times, seconds) = StepTimes::run(sim, steps, |sim| {
         cg_iterations += sim.workspace().cg_iterations();
     })?;
+    let contacts = sim.workspace().contact_stats();
     let figures = SceneFigures {
         cg_iterations_per_step: cg_iterations as f64 / steps as f64,
         dt: sim.dt(),
@@ -352,6 +359,8 @@ fn scene_steps(
         steps_per_s: steps as f64 / seconds,
         median_step_s: times.median(),
         fastest_step_s: times.fastest(),
+        contact_share: (contacts.seconds - contacts_before.seconds) / seconds,
+        contact_rebuilds: contacts.rebuilds - contacts_before.rebuilds,
     };
     if json {
         println!("{}", serde_json::to_string(&figures)?);
@@ -359,7 +368,7 @@ fn scene_steps(
         println!(
             "{}: {} particles, {} springs, {steps} {} steps of {} s on {} threads ({} kernel) \
              in {:.3} s: {:.0} steps/s (median step {:.1} µs, fastest {:.1} µs), {:.3} s per \
-             simulated second{}",
+             simulated second; contacts {:.0}% of the time ({} candidate rebuilds){}",
             figures.scene,
             figures.particles,
             figures.springs,
@@ -372,6 +381,8 @@ fn scene_steps(
             figures.median_step_s * 1e6,
             figures.fastest_step_s * 1e6,
             seconds / (steps as f64 * figures.dt),
+            100.0 * figures.contact_share,
+            figures.contact_rebuilds,
             if cg_iterations > 0 {
                 format!(
                     ", {:.1} CG iterations per step",

@@ -2,7 +2,7 @@
 
 use hooke_core::{SpringKind, Vec3};
 use hooke_render::{Camera, DrawList, Line, Mesh, Point, Rgb};
-use hooke_scene::{ColliderGeometry, Scene, Topology};
+use hooke_scene::{ColliderGeometry, Scene, Topology, collider_mesh};
 
 /// What to draw of the bodies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -24,8 +24,6 @@ const PIN: Rgb = [0.30, 0.30, 0.34];
 const TABLE: Rgb = [0.58, 0.40, 0.24];
 const PLANE: Rgb = [0.85, 0.55, 0.65];
 const EDGE: Rgb = [0.25, 0.28, 0.35];
-/// How far below their true place colliders are drawn, metres.
-const DRAW_SINK: f64 = 0.002;
 const GROUND: [Rgb; 2] = [[0.78, 0.78, 0.76], [0.68, 0.68, 0.66]];
 
 /// The spring palette: the course's white / red / yellow, darkened to read on a light ground.
@@ -102,29 +100,8 @@ fn ground(list: &mut DrawList, height: f64, centre: Vec3, half: f64) {
 }
 
 fn cylinder(list: &mut DrawList, c: &hooke_collide::Cylinder) {
-    let segments = 64;
-    let top = c.center.y;
-    let bottom = top - c.thickness;
-    for k in 0..segments {
-        let a0 = std::f64::consts::TAU * k as f64 / segments as f64;
-        let a1 = std::f64::consts::TAU * (k + 1) as f64 / segments as f64;
-        let rim = |a: f64, y: f64| {
-            Vec3::new(
-                c.center.x + c.radius * a.cos(),
-                y,
-                c.center.z + c.radius * a.sin(),
-            )
-        };
-        list.flat(
-            [
-                Vec3::new(c.center.x, top, c.center.z),
-                rim(a1, top),
-                rim(a0, top),
-            ],
-            TABLE,
-        );
-        list.flat([rim(a0, bottom), rim(a1, top), rim(a1, bottom)], TABLE);
-        list.flat([rim(a0, bottom), rim(a0, top), rim(a1, top)], TABLE);
+    for t in collider_mesh::cylinder_triangles(c) {
+        list.flat(t, TABLE);
     }
 }
 
@@ -169,17 +146,8 @@ fn coil(list: &mut DrawList, a: Vec3, b: Vec3, rest: f64) {
 }
 
 /// Corner `k` of the box: x from bit 2, y from bit 1, z from bit 0.
-fn box_corner(min: Vec3, max: Vec3, k: usize) -> Vec3 {
-    let pick = |bit: usize, lo: f64, hi: f64| if k & bit != 0 { hi } else { lo };
-    Vec3::new(
-        pick(4, min.x, max.x),
-        pick(2, min.y, max.y),
-        pick(1, min.z, max.z),
-    )
-}
-
 fn box_edges(list: &mut DrawList, min: Vec3, max: Vec3) {
-    let corner = |k: usize| box_corner(min, max, k);
+    let corner = |k: usize| collider_mesh::box_corner(min, max, k);
     for a in 0..8 {
         for bit in [1, 2, 4] {
             if a & bit == 0 {
@@ -196,32 +164,11 @@ fn box_edges(list: &mut DrawList, min: Vec3, max: Vec3) {
 
 /// The polygon where the plane `a x + b y + c z + d = 0` cuts the box, as a triangle fan.
 fn plane_in_box(list: &mut DrawList, coefficients: [f64; 4], min: Vec3, max: Vec3) {
-    let [a, b, c, d] = coefficients;
-    let f = |p: &Vec3| a * p.x + b * p.y + c * p.z + d;
-    let corner = |k: usize| box_corner(min, max, k);
-    let mut points = Vec::new();
-    for k in 0..8 {
-        for bit in [1, 2, 4] {
-            if k & bit == 0 {
-                let (p, q) = (corner(k), corner(k | bit));
-                let (fp, fq) = (f(&p), f(&q));
-                if (fp <= 0.0) != (fq <= 0.0) {
-                    points.push(p + (q - p) * (fp / (fp - fq)));
-                }
-            }
-        }
-    }
-    if points.len() < 3 {
+    let points = collider_mesh::plane_in_box(coefficients, min, max);
+    if points.is_empty() {
         return;
     }
     let centre = points.iter().sum::<Vec3>() / points.len() as f64;
-    let n = Vec3::new(a, b, c).normalize();
-    let u = (points[0] - centre).normalize();
-    let v = n.cross(&u);
-    points.sort_by(|p, q| {
-        let ang = |x: &Vec3| (x - centre).dot(&v).atan2((x - centre).dot(&u));
-        ang(p).total_cmp(&ang(q))
-    });
     for k in 0..points.len() {
         list.flat([centre, points[k], points[(k + 1) % points.len()]], PLANE);
         list.lines.push(Line {
@@ -313,10 +260,8 @@ pub fn draw_with(scene: &Scene, style: Style, show: impl Fn(SpringKind) -> bool)
     let mut box_bounds = None;
     for c in &scene.colliders {
         match c {
-            // Drawn 2 mm low: cloth resting exactly on a top would otherwise fight it in depth.
-            ColliderGeometry::Mesh(tris) => tris
-                .iter()
-                .for_each(|t| list.flat(t.map(|p| p - Vec3::y() * DRAW_SINK), TABLE)),
+            // Drawn where they are: contacts keep cloth a thickness away from them.
+            ColliderGeometry::Mesh(tris) => tris.iter().for_each(|t| list.flat(*t, TABLE)),
             ColliderGeometry::Cylinder(cyl) => cylinder(&mut list, cyl),
             ColliderGeometry::Box(b) => {
                 box_edges(&mut list, b.min, b.max);

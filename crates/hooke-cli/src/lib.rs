@@ -7,6 +7,7 @@
 pub mod draw;
 pub mod image_out;
 pub mod interrupt;
+pub mod obj_export;
 pub mod output;
 pub mod source;
 pub mod stills;

@@ -109,7 +109,7 @@ struct RunArgs {
     scene: String,
     #[command(flatten)]
     setup: SetupArgs,
-    /// Write the trajectory (SPEC §6 CSV) here.
+    /// Write the trajectory here (CSV as in docs/physics.md §6).
     #[arg(long, value_name = "FILE.csv")]
     trajectory: Option<PathBuf>,
     /// Print a summary line per frame: energies, bounding box, max speed, max penetration.
@@ -121,6 +121,10 @@ struct RunArgs {
     /// Write the frames as a looping GIF animation.
     #[arg(long, value_name = "FILE.gif")]
     gif: Option<PathBuf>,
+    /// Write every frame as a Wavefront OBJ (DIR/frame-00000.obj, ...) in world coordinates:
+    /// bodies as `body:<name>`, colliders as `collider:<index>-<kind>`.
+    #[arg(long, value_name = "DIR")]
+    export_obj: Option<PathBuf>,
     #[command(flatten)]
     view: image_out::View,
 }

@@ -192,7 +192,14 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         args.view.clone(),
         every as f64 * dt,
     )?;
+    let export = match &args.export_obj {
+        Some(dir) => Some(hooke_cli::obj_export::ObjExport::new(dir, &scene)?),
+        None => None,
+    };
     let result = drive(&mut scene, |frame, scene| {
+        if let Some(e) = &export {
+            e.frame(frame, scene)?;
+        }
         let sim = &scene.simulation;
         // SPEC §6: the time of frame f is (f K) dt computed as one product.
         let time = (frame * every) as f64 * dt;

@@ -62,4 +62,26 @@ impl Collider for BoxInterior {
             }
         }
     }
+
+    fn contacts_within(&self, p: &Vec3, margin: f64, sink: &mut dyn FnMut(Contact)) {
+        if margin == 0.0 {
+            return self.contacts(p, sink);
+        }
+        for axis in 0..3 {
+            for (face, inward) in [(self.min[axis], 1.0), (self.max[axis], -1.0)] {
+                let distance = (p[axis] - face) * inward;
+                if distance < margin {
+                    let mut normal = Vec3::zeros();
+                    normal[axis] = inward;
+                    let mut point = *p;
+                    point[axis] = face;
+                    sink(Contact {
+                        depth: margin - distance,
+                        normal,
+                        point,
+                    });
+                }
+            }
+        }
+    }
 }

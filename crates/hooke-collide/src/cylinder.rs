@@ -1,6 +1,6 @@
 //! The analytic cylinder tabletop of the course document.
 
-use hooke_core::{Collider, Contact, Vec3};
+use hooke_core::{Circle, Collider, Contact, Feature, Vec3};
 
 /// A solid vertical disc: top face at `y = Y`, bottom at `Y - thickness`, radius `R` about
 /// the vertical axis through `(X, Z)`.
@@ -26,6 +26,44 @@ pub struct Cylinder {
     pub radius: f64,
     /// Thickness `h`, metres.
     pub thickness: f64,
+}
+
+impl Cylinder {
+    /// The rims of the top (`y = Y`) and bottom (`y = Y - h`) faces.
+    pub fn rims(&self) -> [Circle; 2] {
+        [0.0, self.thickness].map(|drop| Circle {
+            center: self.center - Vec3::y() * drop,
+            axis: Vec3::y(),
+            radius: self.radius,
+        })
+    }
+
+    /// The nearest point of the solid to `p` outside it, and the outward normal there.
+    fn nearest_outside(&self, p: &Vec3) -> (Vec3, Vec3) {
+        let (dx, dz) = (p.x - self.center.x, p.z - self.center.z);
+        let r = (dx * dx + dz * dz).sqrt();
+        let top = self.center.y;
+        let bottom = top - self.thickness;
+        let scale = if r > self.radius {
+            self.radius / r
+        } else {
+            1.0
+        };
+        let q = Vec3::new(
+            self.center.x + dx * scale,
+            p.y.clamp(bottom, top),
+            self.center.z + dz * scale,
+        );
+        let d = p - q;
+        let normal = match d.try_normalize(0.0) {
+            Some(n) => n,
+            // On the surface itself: the face it lies on.
+            None if p.y >= top => Vec3::y(),
+            None if p.y <= bottom => -Vec3::y(),
+            None => Vec3::new(dx / r, 0.0, dz / r),
+        };
+        (q, normal)
+    }
 }
 
 impl Collider for Cylinder {
@@ -77,5 +115,41 @@ impl Collider for Cylinder {
             }
         };
         sink(contact);
+    }
+
+    /// Inside: the nearest face, `margin` further out. Outside: the nearest point of the
+    /// solid (on a face or a rim), when nearer than `margin`.
+    fn contacts_within(&self, p: &Vec3, margin: f64, sink: &mut dyn FnMut(Contact)) {
+        let mut inside = false;
+        self.contacts(p, &mut |mut c| {
+            inside = true;
+            c.depth += margin;
+            sink(c);
+        });
+        if inside || margin == 0.0 {
+            return;
+        }
+        let (point, normal) = self.nearest_outside(p);
+        let distance = (p - point).norm();
+        if distance < margin {
+            sink(Contact {
+                depth: margin - distance,
+                normal,
+                point,
+            });
+        }
+    }
+
+    fn features(&self, lo: &Vec3, hi: &Vec3, sink: &mut dyn FnMut(hooke_core::Feature)) {
+        for rim in self.rims() {
+            let (a, b) = Feature::Circle(rim).bounds();
+            if (0..3).all(|k| a[k] <= hi[k] && lo[k] <= b[k]) {
+                sink(Feature::Circle(rim));
+            }
+        }
+    }
+
+    fn has_features(&self) -> bool {
+        true
     }
 }

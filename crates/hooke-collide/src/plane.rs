@@ -91,4 +91,21 @@ impl Collider for Plane {
             });
         }
     }
+
+    fn contacts_within(&self, p: &Vec3, margin: f64, sink: &mut dyn FnMut(Contact)) {
+        if margin == 0.0 {
+            return self.contacts(p, sink);
+        }
+        let [a, b, c, _] = self.coefficients;
+        let norm = self.norm();
+        let distance = self.side * self.f(p) / norm;
+        if distance < margin {
+            let normal = Vec3::new(a, b, c) * self.side / norm;
+            sink(Contact {
+                depth: margin - distance,
+                normal,
+                point: p - normal * distance,
+            });
+        }
+    }
 }

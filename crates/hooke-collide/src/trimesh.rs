@@ -2,7 +2,7 @@
 //! answers the crossing test so that a thin tabletop cannot be tunnelled through.
 
 use crate::obj::{MeshError, MeshPart};
-use hooke_core::{Collider, Contact, Vec3};
+use hooke_core::{Collider, Contact, Feature, Vec3};
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::query::{PointQuery, Ray, RayCast};
@@ -16,6 +16,10 @@ const CROSSING_EPSILON: f64 = 1e-9;
 /// A particle stopped at a crossing is left this far on the side it came from, so the next
 /// step's ray starts clear of the surface.
 const CROSSING_STANDOFF: f64 = 1e-7;
+/// Two faces meeting at an edge count as one flat surface when the far corner of one lies
+/// within this fraction of the edge's length of the other's plane (an angle under about
+/// 0.06°): the diagonals of a flat top are no edges a cloth can catch on.
+const FLAT_TOLERANCE: f64 = 1e-3;
 
 #[derive(Clone, Debug)]
 struct Part {
@@ -24,6 +28,9 @@ struct Part {
     closed: bool,
     /// Bounds of the part, for a cheap rejection before parry's BVH query.
     aabb: Aabb,
+    /// Per triangle, bit `k` set when its edge `k → k+1` is a sharp feature it owns (see
+    /// [`feature_edges`]).
+    features: Vec<u8>,
 }
 
 /// A collider made of the objects of one OBJ file.
@@ -129,7 +136,13 @@ impl TriMeshCollider {
                 }
             })?;
             let aabb = mesh.local_aabb();
-            built.push(Part { mesh, closed, aabb });
+            let features = feature_edges(&mesh, closed);
+            built.push(Part {
+                mesh,
+                closed,
+                aabb,
+                features,
+            });
         }
         Ok(Self {
             label,
@@ -162,9 +175,70 @@ impl TriMeshCollider {
     }
 }
 
+/// Which edges of a mesh a cloth can catch on, as a bit mask per triangle: boundary edges,
+/// edges of three or more faces, and edges between two faces at an angle, where for a solid
+/// only convex edges count (a concave valley cannot poke through a sheet whose corners are
+/// outside). Each edge is owned by the lowest triangle that has it, so it is reported once.
+fn feature_edges(mesh: &ParryMesh, closed: bool) -> Vec<u8> {
+    let v = mesh.vertices();
+    let idx = mesh.indices();
+    let mut by_edge: HashMap<(u32, u32), Vec<(u32, u8)>> = HashMap::new();
+    for (t, tri) in idx.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            by_edge
+                .entry((a.min(b), a.max(b)))
+                .or_default()
+                .push((t as u32, k as u8));
+        }
+    }
+    let mut mask = vec![0u8; idx.len()];
+    for (&(a, b), faces) in &by_edge {
+        let sharp = match faces.as_slice() {
+            [(t1, _), (t2, _)] => {
+                let corner = |t: u32, skip: [u32; 2]| {
+                    idx[t as usize]
+                        .into_iter()
+                        .find(|i| !skip.contains(i))
+                        .map(|i| from_parry(v[i as usize]))
+                };
+                let tri = idx[*t1 as usize].map(|i| from_parry(v[i as usize]));
+                let normal = (tri[1] - tri[0]).cross(&(tri[2] - tri[0]));
+                let (pa, pb) = (from_parry(v[a as usize]), from_parry(v[b as usize]));
+                let length = (pb - pa).norm();
+                match (normal.try_normalize(0.0), corner(*t2, [a, b])) {
+                    (Some(n), Some(far)) => {
+                        let height = (far - pa).dot(&n);
+                        // For a solid with outward normals, the far corner below the first
+                        // face's plane makes the edge convex.
+                        height.abs() > FLAT_TOLERANCE * length && (!closed || height < 0.0)
+                    }
+                    _ => true,
+                }
+            }
+            _ => true,
+        };
+        if sharp {
+            let &(t, k) = faces.iter().min().expect("an edge has a face");
+            mask[t as usize] |= 1 << k;
+        }
+    }
+    mask
+}
+
 fn in_aabb(aabb: &Aabb, p: &Vec3) -> bool {
+    in_aabb_within(aabb, p, 0.0)
+}
+
+/// Whether `p` is within `margin` of the box.
+fn in_aabb_within(aabb: &Aabb, p: &Vec3, margin: f64) -> bool {
     let (lo, hi) = (aabb.mins, aabb.maxs);
-    lo.x <= p.x && p.x <= hi.x && lo.y <= p.y && p.y <= hi.y && lo.z <= p.z && p.z <= hi.z
+    lo.x - margin <= p.x
+        && p.x <= hi.x + margin
+        && lo.y - margin <= p.y
+        && p.y <= hi.y + margin
+        && lo.z - margin <= p.z
+        && p.z <= hi.z + margin
 }
 
 impl Collider for TriMeshCollider {
@@ -206,6 +280,84 @@ impl Collider for TriMeshCollider {
                 });
             }
         }
+    }
+
+    /// Inside a solid part: to its nearest surface point and `margin` beyond. Outside any
+    /// part (solid or sheet) but nearer than `margin` to it: away from its nearest point.
+    fn contacts_within(&self, p: &Vec3, margin: f64, sink: &mut dyn FnMut(Contact)) {
+        if margin == 0.0 {
+            return self.contacts(p, sink);
+        }
+        for part in self
+            .parts
+            .iter()
+            .filter(|part| in_aabb_within(&part.aabb, p, margin))
+        {
+            // Only a point in a solid's box can be inside it; elsewhere only the shell of
+            // width `margin` matters, which parry's bounded query answers without a full
+            // projection.
+            let proj = if part.closed && in_aabb(&part.aabb, p) {
+                part.mesh.project_local_point(to_parry(p), false)
+            } else {
+                match part
+                    .mesh
+                    .project_local_point_with_max_dist(to_parry(p), false, margin)
+                {
+                    Some(proj) => proj,
+                    None => continue,
+                }
+            };
+            let point = from_parry(proj.point);
+            let offset = point - p;
+            let distance = offset.norm();
+            if part.closed && proj.is_inside {
+                if distance > 0.0 {
+                    sink(Contact {
+                        depth: distance + margin,
+                        normal: offset / distance,
+                        point,
+                    });
+                }
+            } else if distance < margin && distance > 0.0 {
+                sink(Contact {
+                    depth: margin - distance,
+                    normal: -offset / distance,
+                    point,
+                });
+            }
+        }
+    }
+
+    fn features(&self, lo: &Vec3, hi: &Vec3, sink: &mut dyn FnMut(Feature)) {
+        let query = Aabb::new(to_parry(lo), to_parry(hi));
+        for part in &self.parts {
+            let (a, b) = (part.aabb.mins, part.aabb.maxs);
+            if hi.x < a.x || lo.x > b.x || hi.y < a.y || lo.y > b.y || hi.z < a.z || lo.z > b.z {
+                continue;
+            }
+            let v = part.mesh.vertices();
+            let idx = part.mesh.indices();
+            let mut found: Vec<u32> = part.mesh.bvh().intersect_aabb(&query).collect();
+            // The BVH's order is its own; features go out by triangle.
+            found.sort_unstable();
+            for t in found {
+                let mask = part.features[t as usize];
+                let tri = idx[t as usize];
+                for k in 0..3 {
+                    if mask & (1 << k) != 0 {
+                        let a = from_parry(v[tri[k] as usize]);
+                        let b = from_parry(v[tri[(k + 1) % 3] as usize]);
+                        sink(Feature::Segment([a, b]));
+                    }
+                }
+            }
+        }
+    }
+
+    fn has_features(&self) -> bool {
+        self.parts
+            .iter()
+            .any(|p| p.features.iter().any(|&m| m != 0))
     }
 
     fn crossing(&self, from: &Vec3, to: &Vec3) -> Option<Contact> {

@@ -538,7 +538,7 @@ impl Assembly {
     /// forces, attachments and springs.
     #[inline]
     pub fn force(model: &Model, mass: f64, x: &Vec3, v: &Vec3, p: usize, springs: Vec3) -> Vec3 {
-        let f = model.external_force(mass, x, v) + springs;
+        let f = model.external_force(p, mass, x, v) + springs;
         if model.attachments.is_empty() {
             f
         } else {

@@ -1,5 +1,6 @@
 //! The `Collider` trait the core owns; concrete shapes live in `hooke-collide`.
 
+use crate::contact::proximity::Circle;
 use crate::particles::Vec3;
 use std::fmt::Debug;
 
@@ -14,6 +15,32 @@ pub struct Contact {
     pub point: Vec3,
 }
 
+/// A sharp part of a collider's surface that a cloth face can touch between its particles:
+/// an edge where two faces meet at an angle, the rim of a disc. Faces are covered by the
+/// per-particle contacts; features are what pokes through a cloth triangle whose corners are
+/// all outside.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Feature {
+    /// A straight edge between two points (a mesh edge, a corner where it ends).
+    Segment([Vec3; 2]),
+    /// A circular edge (the analytic cylinder's rims).
+    Circle(Circle),
+}
+
+impl Feature {
+    /// The feature's bounding box `(lo, hi)`.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        match self {
+            Self::Segment([a, b]) => (a.inf(b), a.sup(b)),
+            Self::Circle(c) => {
+                // Per axis, a circle extends r·√(1 - axis²) from its centre.
+                let e = c.axis.map(|a| c.radius * (1.0 - a * a).max(0.0).sqrt());
+                (c.center - e, c.center + e)
+            }
+        }
+    }
+}
+
 /// A solid (or thin) obstacle that particles must stay out of (SPEC §2).
 ///
 /// Implementors answer point queries; the responses (penalty, restitution, stick) are the
@@ -25,6 +52,30 @@ pub trait Collider: Debug + Send + Sync {
     /// Calls `sink` once for every violated surface at `p` (a box can report up to three
     /// faces; most shapes report zero or one).
     fn contacts(&self, p: &Vec3, sink: &mut dyn FnMut(Contact));
+
+    /// [`Collider::contacts`] for a particle that keeps `margin` metres from the surface (a
+    /// body's contact thickness): also reports points outside but nearer than `margin`, with
+    /// `depth = margin - distance` (so moving by `depth · normal` puts the point `margin` out)
+    /// and `point` the nearest surface point. With `margin == 0` this is exactly `contacts`,
+    /// which the default always calls: shapes that support a margin override it.
+    fn contacts_within(&self, p: &Vec3, margin: f64, sink: &mut dyn FnMut(Contact)) {
+        self.contacts(p, &mut |mut c| {
+            c.depth += margin;
+            sink(c);
+        });
+    }
+
+    /// Calls `sink` with every sharp [`Feature`] of the surface that may lie in the box
+    /// `lo..hi` (more is allowed, fewer is not). Smooth shapes (planes, the box interior,
+    /// whose edges are concave from the free side) have none, the default.
+    fn features(&self, lo: &Vec3, hi: &Vec3, sink: &mut dyn FnMut(Feature)) {
+        let _ = (lo, hi, sink);
+    }
+
+    /// Whether [`Collider::features`] can report anything, so callers may skip asking.
+    fn has_features(&self) -> bool {
+        false
+    }
 
     /// For thin or open shapes: if the straight path `from → to` of one step crosses the
     /// surface although `to` is not inside, the surface point where it crossed, with the normal

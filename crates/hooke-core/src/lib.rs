@@ -32,6 +32,7 @@
 
 mod assembly;
 mod collider;
+pub mod contact;
 mod force_field;
 pub mod integrator;
 mod kernel;
@@ -43,9 +44,12 @@ mod simulation;
 mod spring;
 mod stability;
 mod summary;
+mod surface;
 
 pub use assembly::{Assembly, Sym3};
-pub use collider::{Collider, Contact};
+pub use collider::{Collider, Contact, Feature};
+pub use contact::ContactStats;
+pub use contact::proximity::Circle;
 pub use force_field::{FIELD_HALF_EXTENT, ForceField};
 pub use integrator::{Integrator, UnknownIntegrator, Workspace};
 pub use kernel::{Kernel, UnknownKernel};
@@ -56,3 +60,4 @@ pub use simulation::{Divergence, SANE_BOUND, Simulation};
 pub use spring::{DEGENERATE_LENGTH, Spring, SpringKind};
 pub use stability::StabilityEstimate;
 pub use summary::Summary;
+pub use surface::{DEFAULT_CLOTH_THICKNESS, DEFAULT_SURFACE_FRICTION, Surface};

@@ -6,6 +6,7 @@ use crate::parallel;
 use crate::particles::Vec3;
 use crate::response::Response;
 use crate::spring::Spring;
+use crate::surface::Surface;
 
 /// A collider together with the response it triggers.
 #[derive(Debug)]
@@ -34,6 +35,9 @@ pub struct Model {
     pub colliders: Vec<ColliderSlot>,
     /// Particles tied to points in space, such as a particle grabbed with the mouse.
     pub attachments: Vec<Attachment>,
+    /// The bodies' surfaces that take part in contacts (see [`crate::contact`]); empty for
+    /// systems of bare particles, whose contacts are SPEC's per-particle tests alone.
+    pub surfaces: Vec<Surface>,
 }
 
 /// A zero-length damped spring from a particle to a point in space: the force
@@ -70,9 +74,26 @@ impl Model {
         self.colliders.iter().any(|c| !c.response.is_force())
     }
 
-    /// Every force on one particle except its springs': gravity, field, drag, penalties.
+    /// Whether the contact phase after each step has work: velocity-level responses or
+    /// surfaces with a thickness. It reads the step's start positions.
+    pub fn has_contact_phase(&self) -> bool {
+        self.has_contact_responses() || self.surfaces.iter().any(Surface::is_active)
+    }
+
+    /// The contact thickness of particle `p`: its surface's, zero for particles outside
+    /// every surface.
     #[inline]
-    pub fn external_force(&self, mass: f64, x: &Vec3, v: &Vec3) -> Vec3 {
+    pub fn margin(&self, p: usize) -> f64 {
+        self.surfaces
+            .iter()
+            .find(|s| s.particles.contains(&p))
+            .map_or(0.0, |s| s.thickness)
+    }
+
+    /// Every force on particle `p` except its springs': gravity, field, drag, penalties (with
+    /// the particle's contact thickness as the penalty springs' margin).
+    #[inline]
+    pub fn external_force(&self, p: usize, mass: f64, x: &Vec3, v: &Vec3) -> Vec3 {
         let mut f = self.gravity * mass;
         if let Some(field) = &self.field {
             f += field.sample(x);
@@ -80,10 +101,16 @@ impl Model {
         if self.drag != 0.0 {
             f -= v * self.drag;
         }
+        let mut margin = None;
         for slot in &self.colliders {
             if slot.response.is_force() {
-                slot.shape
-                    .contacts(x, &mut |c: Contact| f += slot.response.penalty_force(&c, v));
+                let m = *margin.get_or_insert_with(|| self.margin(p));
+                let mut add = |c: Contact| f += slot.response.penalty_force(&c, v);
+                if m == 0.0 {
+                    slot.shape.contacts(x, &mut add);
+                } else {
+                    slot.shape.contacts_within(x, m, &mut add);
+                }
             }
         }
         f
@@ -107,10 +134,14 @@ impl Model {
     /// holds stuck particles in place, so they are not re-detected). Explicit integrators
     /// ignore it.
     ///
+    /// `margin[p]` is particle `p`'s contact thickness (an empty slice: zero for all): the
+    /// responses put it that far out of the surface.
+    ///
     /// Returns whether any response ran (the model has velocity-level colliders).
     pub fn resolve_contacts(
         &self,
         inv_mass: &[f64],
+        margin: &[f64],
         x0: &[Vec3],
         x: &mut [Vec3],
         v: &mut [Vec3],
@@ -122,29 +153,52 @@ impl Model {
         let resolve = |start: usize, x: &mut [Vec3], v: &mut [Vec3], stuck: &mut [bool]| {
             for k in 0..x.len() {
                 let p = start + k;
-                if inv_mass[p] == 0.0 {
-                    continue;
-                }
-                let mut held = stuck[k] && x[k] == x0[p];
-                for slot in self.colliders.iter().filter(|c| !c.response.is_force()) {
-                    let here = x[k];
-                    let mut touched = false;
-                    slot.shape.contacts(&here, &mut |c| {
-                        touched = true;
-                        slot.response.resolve(&c, &mut x[k], &mut v[k]);
-                    });
-                    if !touched && let Some(c) = slot.shape.crossing(&x0[p], &here) {
-                        touched = true;
-                        slot.response.resolve(&c, &mut x[k], &mut v[k]);
-                    }
-                    held |= touched && matches!(slot.response, Response::Stick);
-                }
-                stuck[k] = held;
+                let m = margin.get(p).copied().unwrap_or(0.0);
+                stuck[k] =
+                    self.resolve_particle(inv_mass[p], m, &x0[p], &mut x[k], &mut v[k], stuck[k]);
             }
         };
         // Mesh queries cost microseconds each, so even small blocks are worth sharing.
         parallel::for_blocks3(CONTACT_BLOCK, x, v, stuck, resolve);
         true
+    }
+
+    /// The velocity-level responses for one particle with inverse mass `inv_mass` and
+    /// contact thickness `margin`, which started the step at `x0`; `stuck` is whether a stick
+    /// response held it before. Returns whether one holds it now.
+    pub(crate) fn resolve_particle(
+        &self,
+        inv_mass: f64,
+        margin: f64,
+        x0: &Vec3,
+        x: &mut Vec3,
+        v: &mut Vec3,
+        stuck: bool,
+    ) -> bool {
+        if inv_mass == 0.0 {
+            return stuck;
+        }
+        let mut held = stuck && *x == *x0;
+        for slot in self.colliders.iter().filter(|c| !c.response.is_force()) {
+            let here = *x;
+            let mut touched = false;
+            let mut apply = |c: Contact| {
+                touched = true;
+                slot.response.resolve(&c, x, v);
+            };
+            if margin == 0.0 {
+                slot.shape.contacts(&here, &mut apply);
+            } else {
+                slot.shape.contacts_within(&here, margin, &mut apply);
+            }
+            if !touched && let Some(mut c) = slot.shape.crossing(x0, &here) {
+                touched = true;
+                c.depth += margin;
+                slot.response.resolve(&c, x, v);
+            }
+            held |= touched && matches!(slot.response, Response::Stick);
+        }
+        held
     }
 
     /// Total potential energy in joules: springs, gravity (zero at the origin) and penalty

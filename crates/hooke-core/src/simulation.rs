@@ -132,8 +132,8 @@ impl Simulation {
         self.step as f64 * self.dt
     }
 
-    /// Advances one step: the integrator, then the velocity-level collision responses, then
-    /// the divergence check.
+    /// Advances one step: the integrator, then the contact phase (collision responses,
+    /// feature and self contacts, see [`crate::contact`]), then the divergence check.
     pub fn step(&mut self) -> Result<(), Divergence> {
         parallel::on_worker(|| self.step_here())
     }
@@ -146,11 +146,15 @@ impl Simulation {
             self.dt,
             &mut self.workspace,
         );
-        let p = &mut self.particles;
         let ws = &mut self.workspace;
-        let moved =
-            self.model
-                .resolve_contacts(&p.inv_mass, &ws.x0, &mut p.x, &mut p.v, &mut ws.stuck);
+        let moved = self.model.has_contact_phase()
+            && crate::contact::resolve(
+                &self.model,
+                &mut self.particles,
+                &ws.x0,
+                &mut ws.stuck,
+                &mut ws.contacts,
+            );
         self.step += 1;
         // The integrator's own check stands unless contacts moved particles after it.
         let sane = if moved { None } else { ws.sane };

@@ -4,8 +4,8 @@ use crate::generators::Lattice;
 use crate::spec::*;
 use hooke_collide::{BoxInterior, Cylinder, MeshError, Placement, Plane, TriMeshCollider};
 use hooke_core::{
-    Collider, ColliderSlot, ForceField, Model, Particles, Response, Simulation, Spring, SpringKind,
-    Vec3,
+    Collider, ColliderSlot, DEFAULT_CLOTH_THICKNESS, DEFAULT_SURFACE_FRICTION, ForceField, Model,
+    Particles, Response, Simulation, Spring, SpringKind, Surface, Vec3,
 };
 use nalgebra::Rotation3;
 use std::ops::Range;
@@ -92,6 +92,10 @@ pub struct Body {
     pub range: Range<usize>,
     /// Arrangement.
     pub topology: Topology,
+    /// Surface triangles as simulation particle indices (empty for chains and points).
+    pub triangles: Vec<[u32; 3]>,
+    /// Contact thickness of the surface, metres (zero: SPEC's bare particle contacts).
+    pub thickness: f64,
 }
 
 /// The geometry of a collider, for drawing.
@@ -267,6 +271,7 @@ impl SceneSpec {
         let mut particles = Particles::default();
         let mut springs = Vec::new();
         let mut bodies = Vec::new();
+        let mut surfaces = Vec::new();
         for (b, body) in self.bodies.iter().enumerate() {
             let key = format!("body[{b}] '{}'", body.name);
             let start = particles.len();
@@ -330,11 +335,18 @@ impl SceneSpec {
                 particles.pin(start + pin);
             }
             springs.extend(built.springs);
+            let triangles = crate::surface::triangles(built.topology, start);
+            let surface = body_surface(body, &key, &built.local, start..start + n, triangles)?;
             bodies.push(Body {
                 name: body.name.clone(),
                 range: start..start + n,
                 topology: built.topology,
+                triangles: surface.triangles.clone(),
+                thickness: surface.thickness,
             });
+            if surface.is_active() {
+                surfaces.push(surface);
+            }
         }
         let centroid = if particles.is_empty() {
             Vec3::zeros()
@@ -388,6 +400,7 @@ impl SceneSpec {
             field,
             colliders: slots,
             attachments: Vec::new(),
+            surfaces,
         };
         let simulation = Simulation::new(
             particles,
@@ -404,6 +417,58 @@ impl SceneSpec {
             colliders: geometry,
         })
     }
+}
+
+/// The contact surface of a body: its triangles with the thickness, self-collision and
+/// friction its spec gives or the defaults for its shape.
+fn body_surface(
+    body: &BodySpec,
+    key: &str,
+    local: &[Vec3],
+    particles: Range<usize>,
+    triangles: Vec<[u32; 3]>,
+) -> Result<Surface, BuildError> {
+    let default = match body.shape {
+        // A quarter of the spacing at most, so a fine cloth's neighbours never touch.
+        ShapeSpec::Grid { spacing, .. } => DEFAULT_CLOTH_THICKNESS.min(0.25 * spacing.0),
+        _ => 0.0,
+    };
+    let thickness = body.thickness.map_or(default, |h| h.0);
+    if thickness > 0.0 && triangles.is_empty() {
+        return Err(invalid(
+            format!("{key}.thickness"),
+            "only bodies with a surface (grid, lattice) have a contact thickness; remove it",
+        ));
+    }
+    let self_collision = body.self_collision.unwrap_or(true);
+    let surface = Surface {
+        particles,
+        triangles,
+        thickness,
+        self_collision,
+        friction: body.friction.map_or(DEFAULT_SURFACE_FRICTION, |f| f.0),
+    };
+    if thickness > 0.0 && self_collision && !surface.triangles.is_empty() {
+        // Measured on the rest shape, which is what the springs keep.
+        let start = surface.particles.start;
+        let rest = |i: u32| local[i as usize - start];
+        let shortest = surface
+            .edges()
+            .iter()
+            .map(|&[a, b]| (rest(a) - rest(b)).norm())
+            .fold(f64::INFINITY, f64::min);
+        if thickness >= 0.5 * shortest {
+            return Err(invalid(
+                format!("{key}.thickness"),
+                format!(
+                    "{thickness} m is not under half the surface's shortest edge ({shortest:.4} m): \
+                     self-collision would push neighbouring particles apart; \
+                     use a thinner surface or self_collision = false"
+                ),
+            ));
+        }
+    }
+    Ok(surface)
 }
 
 struct BuiltBody {

@@ -20,8 +20,10 @@
 
 mod build;
 pub mod builtin;
+pub mod collider_mesh;
 pub mod generators;
 pub mod spec;
+pub mod surface;
 pub mod workload;
 pub mod world;
 

@@ -206,6 +206,19 @@ pub struct BodySpec {
     /// Springs by topology and explicit pairs.
     #[serde(default)]
     pub springs: SpringsSpec,
+    /// Contact thickness in metres: colliders and other surfaces are kept this far from the
+    /// body's particles and triangles (`docs/physics.md` §3). Default: 5 mm for a `grid`
+    /// (cloth), capped at a quarter of its spacing; 0 for other shapes, whose contacts are
+    /// then exactly SPEC's per-particle tests. Chains and points have no surface.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness: Option<NonNegative>,
+    /// Whether the body's surface collides with itself (default: on when it has a
+    /// thickness). Collisions with other bodies' surfaces are on whenever either has one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub self_collision: Option<bool>,
+    /// Coulomb friction coefficient of the surface against surfaces (default 0.3).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<NonNegative>,
 }
 
 fn origin() -> [Finite; 3] {

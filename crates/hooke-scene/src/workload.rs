@@ -56,6 +56,10 @@ pub fn cloth(n: usize) -> SceneSpec {
                 bend: params(),
                 pairs: Vec::new(),
             },
+            // The workload measures springs alone: no contact phase.
+            thickness: Some(NonNegative(0.0)),
+            self_collision: None,
+            friction: None,
         }],
         colliders: Vec::new(),
         force_field: None,

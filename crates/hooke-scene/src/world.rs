@@ -367,6 +367,10 @@ impl World {
                     bend: springs,
                     pairs: Vec::new(),
                 },
+                // SPEC §5: a world's jelly has SPEC's bare per-particle contacts.
+                thickness: None,
+                self_collision: None,
+                friction: None,
             }],
             colliders,
             force_field: (self.resolution > 0).then(|| ForceFieldSpec {
@@ -411,6 +415,9 @@ impl World {
         };
         if !body.pins.is_empty() {
             return no("jello worlds have no pinned points");
+        }
+        if body.thickness.is_some_and(|h| h.0 != 0.0) {
+            return no("jello worlds have no contact thickness (SPEC's per-particle contacts)");
         }
         let mut penalty = None;
         let mut has_box = false;

@@ -135,6 +135,8 @@ pub struct Workspace {
     pub(crate) implicit: implicit::ImplicitBuffers,
     /// Particles held by a stick response (see [`Model::resolve_contacts`]).
     pub(crate) stuck: Vec<bool>,
+    /// The contact phase's candidate lists and buffers.
+    pub(crate) contacts: crate::contact::ContactState,
     /// The force loop's compilation, when not the detected one.
     pub(crate) kernel: Option<Kernel>,
     /// Whether the integrator found the state it wrote within [`crate::SANE_BOUND`], for
@@ -146,6 +148,11 @@ impl Workspace {
     /// Conjugate-gradient iterations of the last implicit step (0 for other integrators).
     pub fn cg_iterations(&self) -> usize {
         self.implicit.iterations
+    }
+
+    /// Figures of the contact phase: its wall time so far, candidate rebuilds, proximities.
+    pub fn contact_stats(&self) -> crate::contact::ContactStats {
+        self.contacts.stats
     }
 
     /// Lays out `model`'s springs and sizes the buffers for `particles` particles, unless
@@ -175,7 +182,7 @@ impl Workspace {
     }
 
     /// Positions at the start of the last step, if the integrator saved them (every one
-    /// does except symplectic Euler on a model without contact responses).
+    /// does except symplectic Euler on a model without a contact phase).
     pub fn start_positions(&self) -> Option<&[Vec3]> {
         self.start_saved.then_some(self.x0.as_slice())
     }

@@ -2,7 +2,7 @@
 //!
 //! The force gather, the update, saving the start positions and the divergence check are
 //! one pass over the particles: the method that benchmarks run streams each array once per
-//! step. The start positions are saved only for models with contact responses, the one
+//! step. The start positions are saved only for models with a contact phase, the one
 //! reader that needs them exactly (see [`Workspace::start_positions`]).
 
 use super::Workspace;
@@ -13,7 +13,7 @@ use crate::particles::{Particles, Vec3};
 use crate::simulation::SANE_BOUND;
 
 pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) {
-    let save = model.has_contact_responses();
+    let save = model.has_contact_phase();
     ws.start_saved = save;
     match (model.gravity_only(), save) {
         (true, true) => update::<true, true>(model, p, dt, ws),

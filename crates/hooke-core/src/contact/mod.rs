@@ -1,0 +1,701 @@
+//! The contact phase that runs after each integrator step: colliders against particles,
+//! colliders' sharp features against surface triangles, and surfaces against themselves and
+//! each other (the contact model of `docs/physics.md` §3).
+//!
+//! In the spirit of Bridson, Fedkiw & Anderson (2002), contacts are proximities within a
+//! **thickness** `h`, resolved before they become crossings:
+//!
+//! 1. **Faces.** Every particle is tested against every collider with its body's thickness
+//!    as margin and put `h` out of the surface by the collider's response (restitution,
+//!    stick); see [`crate::Model::resolve_contacts`].
+//! 2. **Proximities.** Collider features (mesh edges at an angle, the cylinder's rims)
+//!    nearer than `h` to a surface triangle, and particle–triangle and edge–edge pairs of
+//!    surfaces nearer than `h` (self-collision within a body, and between bodies), each give
+//!    a stencil: weights `w_k` on up to four particles such that `Σ w_k x_k` is the gap
+//!    vector. Sweeps of Gauss–Seidel projections in a fixed order push each gap open to
+//!    `h` along its normal, sharing the correction by inverse mass (`Δx_k ∝ w_k / m_k`).
+//!    Particles moved this way get their face contacts again, so a step ends with every
+//!    particle out of every collider.
+//! 3. **Velocities.** Each stencil's approaching normal velocity is removed (inelastic),
+//!    tangential velocity is cut by Coulomb friction (surfaces) or the collider's response,
+//!    again as impulses shared by inverse mass: momentum is kept, kinetic energy can only
+//!    drop.
+//!
+//! The normal of a gap is its direction now, unless the gap closed or flipped during the
+//! step (compared with the step's start positions): then the start's direction, so a
+//! crossing within one step is undone rather than locked in.
+//!
+//! Candidates come from a hashed grid (`grid.rs`) and are kept while no surface particle
+//! has moved more than half a skin since their build (Verlet lists): pairs of surfaces
+//! relative to the surfaces' mean motion (a falling cloth keeps them), pairs with collider
+//! features absolutely. A resting cloth costs only its narrow phase. Candidate lists and
+//! detection are split into a fixed number of chunks whose results are read in order:
+//! results are the same bits on any thread count.
+
+mod grid;
+pub mod proximity;
+
+use crate::collider::Feature;
+use crate::model::Model;
+use crate::particles::{Particles, Vec3};
+use crate::response::Response;
+use grid::Grid;
+use proximity::{circle_triangle, point_triangle, segment_segment, segment_triangle};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Gauss–Seidel sweeps over the proximities. Proximities that the pushes create are found
+/// on the next step, while still a thickness from crossing.
+const SWEEPS: usize = 4;
+/// Velocity sweeps.
+const VELOCITY_SWEEPS: usize = 2;
+/// Gaps shorter than this have no direction of their own.
+const EPS: f64 = 1e-12;
+/// No surface particle.
+const NONE: u32 = u32::MAX;
+
+/// How a stencil's velocity responds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Rule {
+    /// Surface against surface: inelastic, Coulomb friction with this coefficient.
+    Coulomb(f64),
+    /// Against a collider with restitution `cr`, keeping `keep` of the tangential velocity.
+    Bounce { cr: f64, keep: f64 },
+    /// Against a stick collider: the touching point stops.
+    Stop,
+}
+
+impl Rule {
+    fn of(response: &Response) -> Self {
+        match *response {
+            Response::Restitution { cr, friction } => Self::Bounce {
+                cr,
+                keep: 1.0 - friction,
+            },
+            Response::Stick => Self::Stop,
+            Response::Penalty { .. } => Self::Bounce { cr: 0.0, keep: 1.0 },
+        }
+    }
+}
+
+/// A proximity: `Σ w_k x_k - anchor` is the gap between its two sides.
+#[derive(Clone, Copy, Debug)]
+struct Stencil {
+    ids: [u32; 4],
+    w: [f64; 4],
+    /// 3 (a triangle against a fixed collider point) or 4.
+    len: usize,
+    /// The collider's point (zero for surface pairs).
+    anchor: Vec3,
+    /// The gap's unit normal.
+    n: Vec3,
+    /// The gap to keep, metres.
+    h: f64,
+    rule: Rule,
+}
+
+impl Stencil {
+    fn gap(&self, x: &[Vec3]) -> Vec3 {
+        let mut g = -self.anchor;
+        for k in 0..self.len {
+            g += x[self.ids[k] as usize] * self.w[k];
+        }
+        g
+    }
+
+    /// `Σ w_k² / m_k`: how far the gap moves per unit impulse.
+    fn compliance(&self, inv_mass: &[f64]) -> f64 {
+        (0..self.len)
+            .map(|k| self.w[k] * self.w[k] * inv_mass[self.ids[k] as usize])
+            .sum()
+    }
+
+    /// Adds `w_k / m_k · j` to each particle's entry of `y`.
+    fn spread(&self, inv_mass: &[f64], y: &mut [Vec3], j: Vec3) {
+        for k in 0..self.len {
+            let i = self.ids[k] as usize;
+            y[i] += j * (self.w[k] * inv_mass[i]);
+        }
+    }
+
+    /// Orients the stencil at `x` (see the module docs) and returns its signed gap along the
+    /// normal, or `None` when no direction can be told.
+    fn orient(&mut self, x: &[Vec3], x0: &[Vec3]) -> Option<f64> {
+        let now = self.gap(x);
+        let start = self.gap(x0);
+        let d = now.norm();
+        if d > EPS && now.dot(&start) > 0.0 {
+            self.n = now / d;
+            Some(d)
+        } else {
+            let d0 = start.norm();
+            (d0 > EPS).then(|| {
+                self.n = start / d0;
+                now.dot(&self.n)
+            })
+        }
+    }
+}
+
+/// Contact figures, for benchmarks.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactStats {
+    /// Wall time spent in the contact phase, seconds, since the simulation began.
+    pub seconds: f64,
+    /// Candidate lists rebuilt.
+    pub rebuilds: u64,
+    /// Proximities resolved in the last step.
+    pub proximities: usize,
+    /// Candidate pairs in the current lists.
+    pub candidates: usize,
+    /// Of the rebuilds, those of the surface pairs (the rest rebuilt the feature pairs only).
+    pub surface_rebuilds: u64,
+}
+
+/// A triangle near a collider feature.
+#[derive(Clone, Copy, Debug)]
+struct FeaturePair {
+    tri: u32,
+    feature: Feature,
+    rule: Rule,
+}
+
+/// The contact phase's topology, candidate lists and buffers, kept from step to step.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ContactState {
+    ready: bool,
+    /// Per particle: its surface's thickness (empty when no surface has one).
+    pub(crate) margin: Vec<f64>,
+    /// Per particle: its surface (among the model's), or [`NONE`].
+    surface_of: Vec<u32>,
+    /// Particles of the active surfaces.
+    points: Vec<u32>,
+    tris: Vec<[u32; 3]>,
+    edges: Vec<[u32; 2]>,
+    /// Largest thickness, and how far beyond it candidates reach.
+    h_max: f64,
+    skin: f64,
+    /// Positions at the last build of the surface pairs and of the feature pairs.
+    self_ref: Vec<Vec3>,
+    feature_ref: Vec<Vec3>,
+    point_tri: Vec<[u32; 2]>,
+    edge_edge: Vec<[u32; 2]>,
+    feature_pairs: Vec<FeaturePair>,
+    /// Boxes at the last build: triangles, then edges.
+    tri_box: Vec<(Vec3, Vec3)>,
+    edge_box: Vec<(Vec3, Vec3)>,
+    tri_grid: Grid,
+    edge_grid: Grid,
+    features: Vec<(Feature, Rule)>,
+    active: Vec<Stencil>,
+    /// Per-chunk buffers of the parallel detection and candidate builds.
+    scratch: Vec<Vec<Stencil>>,
+    pair_scratch: Vec<Vec<[u32; 2]>>,
+    moved: Vec<bool>,
+    moved_list: Vec<u32>,
+    pub(crate) stats: ContactStats,
+}
+
+impl ContactState {
+    /// Reads the model's surfaces once: per-particle margins and owners, the primitives.
+    fn prepare(&mut self, model: &Model, n: usize) {
+        self.ready = true;
+        let active: Vec<_> = model
+            .surfaces
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.is_active())
+            .collect();
+        if active.is_empty() {
+            return;
+        }
+        self.margin = vec![0.0; n];
+        self.surface_of = vec![NONE; n];
+        for &(k, s) in &active {
+            for p in s.particles.clone() {
+                self.margin[p] = s.thickness;
+                self.surface_of[p] = k as u32;
+                self.points.push(p as u32);
+            }
+            self.tris.extend(&s.triangles);
+            self.edges.extend(s.edges());
+            self.h_max = self.h_max.max(s.thickness);
+        }
+        // Half a skin of travel between builds: a cloth falling a few metres a second
+        // rebuilds every few steps, a resting one never.
+        self.skin = 2.0 * self.h_max;
+        self.moved = vec![false; n];
+    }
+
+    /// Whether particles `a` and `b`'s surfaces collide, and with what thickness and
+    /// friction.
+    fn pair(&self, model: &Model, a: u32, b: u32) -> Option<(f64, f64)> {
+        pair(model, &self.surface_of, a, b)
+    }
+
+    /// The largest displacement of a surface particle from `x_ref`, measured from `shift`
+    /// (zero for absolute displacements), squared.
+    fn drift2(&self, x: &[Vec3], x_ref: &[Vec3], shift: Vec3) -> f64 {
+        self.points
+            .iter()
+            .map(|&p| (x[p as usize] - x_ref[p as usize] - shift).norm_squared())
+            .fold(0.0, f64::max)
+    }
+
+    /// Rebuilds whichever candidate lists the motion since their builds may have outdated.
+    ///
+    /// A pair's distance changes by at most the two particles' displacements relative to any
+    /// common shift, so the surface pairs are rebuilt when some particle has moved more than
+    /// half a skin relative to the mean motion (a cloth falling as a whole keeps its lists),
+    /// the feature pairs when one has moved that far at all (colliders stand still).
+    fn refresh(&mut self, model: &Model, x: &[Vec3]) {
+        let limit = 0.25 * self.skin * self.skin;
+        let self_stale = self.self_ref.is_empty() || {
+            let n = self.points.len() as f64;
+            let mean = self.points.iter().fold(Vec3::zeros(), |m, &p| {
+                m + (x[p as usize] - self.self_ref[p as usize])
+            }) / n;
+            self.drift2(x, &self.self_ref, mean) > limit
+        };
+        let features_stale =
+            self.feature_ref.is_empty() || self.drift2(x, &self.feature_ref, Vec3::zeros()) > limit;
+        if !(self_stale || features_stale) {
+            return;
+        }
+        self.stats.rebuilds += 1;
+        self.bin(x);
+        if self_stale {
+            self.stats.surface_rebuilds += 1;
+            self.self_ref.clear();
+            self.self_ref.extend_from_slice(x);
+            self.build_surface_pairs(model, x);
+        }
+        if features_stale {
+            self.feature_ref.clear();
+            self.feature_ref.extend_from_slice(x);
+            self.build_feature_pairs(model, x);
+        }
+        self.stats.candidates =
+            self.point_tri.len() + self.edge_edge.len() + self.feature_pairs.len();
+    }
+
+    /// How far candidates reach: the thickness plus the skin.
+    fn reach(&self) -> f64 {
+        self.h_max + self.skin
+    }
+
+    /// Bins the triangles' and edges' boxes at `x`, grown by the reach (edges by half).
+    fn bin(&mut self, x: &[Vec3]) {
+        let reach = self.reach();
+        let bounds = |ids: &[u32]| {
+            ids.iter().fold(
+                (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
+                |(lo, hi), &i| (lo.inf(&x[i as usize]), hi.sup(&x[i as usize])),
+            )
+        };
+        self.tri_box.clear();
+        self.tri_box.extend(self.tris.iter().map(|t| {
+            let (lo, hi) = bounds(t);
+            (lo.add_scalar(-reach), hi.add_scalar(reach))
+        }));
+        self.edge_box.clear();
+        self.edge_box.extend(self.edges.iter().map(|e| {
+            let (lo, hi) = bounds(e);
+            (lo.add_scalar(-0.5 * reach), hi.add_scalar(0.5 * reach))
+        }));
+        let cell = self
+            .tri_box
+            .iter()
+            .chain(&self.edge_box)
+            .map(|(lo, hi)| (hi - lo).max())
+            .fold(reach, f64::max);
+        self.tri_grid.build(cell, self.tri_box.iter().map(|b| b.0));
+        self.edge_grid
+            .build(cell, self.edge_box.iter().map(|b| b.0));
+    }
+
+    /// Particle–triangle and edge–edge candidates at `x` (after [`ContactState::bin`]).
+    fn build_surface_pairs(&mut self, model: &Model, x: &[Vec3]) {
+        let owners = &self.surface_of;
+        // Exact distances at the build: while no particle moves more than half a skin, no
+        // pair farther apart than the thickness plus the skin can come within the thickness.
+        let reach = self.reach();
+        let reach2 = reach * reach;
+        let mut scratch = std::mem::take(&mut self.pair_scratch);
+        let (tris, tri_box, tri_grid) = (&self.tris, &self.tri_box, &self.tri_grid);
+        let (edges, edge_box, edge_grid) = (&self.edges, &self.edge_box, &self.edge_grid);
+
+        // Particle against triangle: the triangle's low cell is the particle's or one below.
+        par_fill(&self.points, &mut scratch, |&p, out| {
+            let xp = x[p as usize];
+            let c = tri_grid.cell_of(&xp);
+            for d in 0..8 {
+                let cell = [c[0] - (d & 1), c[1] - ((d >> 1) & 1), c[2] - ((d >> 2) & 1)];
+                tri_grid.visit(cell, |t| {
+                    let tri = tris[t as usize];
+                    if !tri.contains(&p)
+                        && inside(&xp, &tri_box[t as usize])
+                        && pair(model, owners, p, tri[0]).is_some()
+                    {
+                        let [a, b, c] = tri.map(|i| x[i as usize]);
+                        let w = point_triangle(&xp, &a, &b, &c);
+                        if (a * w[0] + b * w[1] + c * w[2] - xp).norm_squared() < reach2 {
+                            out.push([p, t]);
+                        }
+                    }
+                });
+            }
+        });
+        self.point_tri.clear();
+        append(&mut self.point_tri, &scratch);
+
+        // Edge against edge: each pair once, from its lower edge, over the edge's own cell
+        // and the 13 neighbours of one half-space (the other 13 see it from theirs).
+        let ids: Vec<u32> = (0..edges.len() as u32).collect();
+        par_fill(&ids, &mut scratch, |&e, out| {
+            let c = edge_grid.item_cell(e);
+            let ee = edges[e as usize];
+            for d in 13..27 {
+                let cell = [c[0] + d % 3 - 1, c[1] + (d / 3) % 3 - 1, c[2] + d / 9 - 1];
+                let own = d == 13;
+                edge_grid.visit(cell, |f| {
+                    let ef = edges[f as usize];
+                    if (!own || f > e)
+                        && !ef.contains(&ee[0])
+                        && !ef.contains(&ee[1])
+                        && overlap(&edge_box[e as usize], &edge_box[f as usize])
+                        && pair(model, owners, ee[0], ef[0]).is_some()
+                    {
+                        let [a, b] = ee.map(|i| x[i as usize]);
+                        let [c, d] = ef.map(|i| x[i as usize]);
+                        let (s, t) = segment_segment(&a, &b, &c, &d);
+                        if (a + (b - a) * s - c - (d - c) * t).norm_squared() < reach2 {
+                            out.push([e, f]);
+                        }
+                    }
+                });
+            }
+        });
+        self.edge_edge.clear();
+        append(&mut self.edge_edge, &scratch);
+        self.pair_scratch = scratch;
+    }
+
+    /// Collider feature–triangle candidates at `x` (after [`ContactState::bin`]).
+    fn build_feature_pairs(&mut self, model: &Model, x: &[Vec3]) {
+        let reach = self.reach();
+        self.feature_pairs.clear();
+        self.features.clear();
+        if self.tris.is_empty() {
+            return;
+        }
+        let (lo, hi) = self
+            .tri_box
+            .iter()
+            .fold((self.tri_box[0].0, self.tri_box[0].1), |(lo, hi), b| {
+                (lo.inf(&b.0), hi.sup(&b.1))
+            });
+        for slot in model.colliders.iter().filter(|c| c.shape.has_features()) {
+            let rule = Rule::of(&slot.response);
+            let features = &mut self.features;
+            slot.shape
+                .features(&lo, &hi, &mut |f| features.push((f, rule)));
+        }
+        for &(feature, rule) in &self.features {
+            let (flo, fhi) = feature.bounds();
+            let (c0, c1) = (self.tri_grid.cell_of(&flo), self.tri_grid.cell_of(&fhi));
+            for i in c0[0] - 1..=c1[0] {
+                for j in c0[1] - 1..=c1[1] {
+                    for k in c0[2] - 1..=c1[2] {
+                        let (boxes, pairs) = (&self.tri_box, &mut self.feature_pairs);
+                        let tris = &self.tris;
+                        self.tri_grid.visit([i, j, k], |t| {
+                            let b = &boxes[t as usize];
+                            if overlap(b, &(flo, fhi))
+                                && near_feature(&feature, b)
+                                && feature_gap(&feature, &tris[t as usize], x, reach).is_some()
+                            {
+                                pairs.push(FeaturePair {
+                                    tri: t,
+                                    feature,
+                                    rule,
+                                });
+                            }
+                        });
+                    }
+                }
+            }
+        }
+        // One order whatever the features' order: by triangle, then as found.
+        self.feature_pairs.sort_by_key(|p| p.tri);
+    }
+
+    /// Appends to `active` every candidate whose gap is under its thickness at `x`, in
+    /// candidate order.
+    fn detect(&mut self, model: &Model, x: &[Vec3], x0: &[Vec3]) {
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let keep = |mut s: Stencil, out: &mut Vec<Stencil>| {
+            if s.orient(x, x0).is_some_and(|d| d < s.h) {
+                out.push(s);
+            }
+        };
+        par_fill(&self.feature_pairs, &mut scratch, |pair, out| {
+            let t = self.tris[pair.tri as usize];
+            let h = self.margin[t[0] as usize];
+            if let Some((anchor, w)) = feature_gap(&pair.feature, &t, x, h) {
+                let s = Stencil {
+                    ids: [t[0], t[1], t[2], 0],
+                    w: [w[0], w[1], w[2], 0.0],
+                    len: 3,
+                    anchor,
+                    n: Vec3::zeros(),
+                    h,
+                    rule: pair.rule,
+                };
+                keep(s, out);
+            }
+        });
+        append(&mut self.active, &scratch);
+        par_fill(&self.point_tri, &mut scratch, |&[p, t], out| {
+            let tri = self.tris[t as usize];
+            let Some((h, mu)) = self.pair(model, p, tri[0]) else {
+                return;
+            };
+            let [ia, ib, ic] = tri.map(|i| i as usize);
+            let w = point_triangle(&x[p as usize], &x[ia], &x[ib], &x[ic]);
+            let s = Stencil {
+                ids: [p, tri[0], tri[1], tri[2]],
+                w: [1.0, -w[0], -w[1], -w[2]],
+                len: 4,
+                anchor: Vec3::zeros(),
+                n: Vec3::zeros(),
+                h,
+                rule: Rule::Coulomb(mu),
+            };
+            keep(s, out);
+        });
+        append(&mut self.active, &scratch);
+        par_fill(&self.edge_edge, &mut scratch, |&[e, f], out| {
+            let (ee, ef) = (self.edges[e as usize], self.edges[f as usize]);
+            let Some((h, mu)) = self.pair(model, ee[0], ef[0]) else {
+                return;
+            };
+            let [a, b] = ee.map(|i| x[i as usize]);
+            let [c, d] = ef.map(|i| x[i as usize]);
+            let (s, t) = segment_segment(&a, &b, &c, &d);
+            let st = Stencil {
+                ids: [ee[0], ee[1], ef[0], ef[1]],
+                w: [1.0 - s, s, t - 1.0, -t],
+                len: 4,
+                anchor: Vec3::zeros(),
+                n: Vec3::zeros(),
+                h,
+                rule: Rule::Coulomb(mu),
+            };
+            keep(st, out);
+        });
+        append(&mut self.active, &scratch);
+        self.scratch = scratch;
+    }
+}
+
+/// Chunks of a parallel pass over candidates. Fixed, so that results come out in candidate
+/// order whatever the thread count.
+const CHUNKS: usize = 8;
+/// Fewer candidates than this are not worth a parallel pass.
+const PARALLEL_MIN: usize = 512;
+
+/// Calls `f(item, out)` for every item, filling `bufs` (one per chunk of consecutive
+/// items, [`CHUNKS`] of them) in parallel; reading the buffers in order gives what a
+/// sequential pass would have pushed.
+fn par_fill<T: Sync, U: Send>(
+    items: &[T],
+    bufs: &mut Vec<Vec<U>>,
+    f: impl Fn(&T, &mut Vec<U>) + Sync + Send,
+) {
+    bufs.resize_with(CHUNKS, Vec::new);
+    for b in bufs.iter_mut() {
+        b.clear();
+    }
+    if items.len() < PARALLEL_MIN {
+        for item in items {
+            f(item, &mut bufs[0]);
+        }
+        return;
+    }
+    let per = items.len().div_ceil(CHUNKS);
+    bufs.par_iter_mut().enumerate().for_each(|(k, out)| {
+        for item in items.iter().skip(k * per).take(per) {
+            f(item, out);
+        }
+    });
+}
+
+/// Appends the chunk buffers of [`par_fill`] to `dst` in order.
+fn append<U: Copy>(dst: &mut Vec<U>, bufs: &[Vec<U>]) {
+    for b in bufs {
+        dst.extend_from_slice(b);
+    }
+}
+
+/// The closest points of a collider feature and triangle `t` at `x`: the feature's point
+/// and the triangle's barycentric weights; `None` when a cheap bound shows they are farther
+/// apart than `within`.
+fn feature_gap(
+    feature: &Feature,
+    t: &[u32; 3],
+    x: &[Vec3],
+    within: f64,
+) -> Option<(Vec3, [f64; 3])> {
+    let (a, b, c) = (&x[t[0] as usize], &x[t[1] as usize], &x[t[2] as usize]);
+    match feature {
+        Feature::Segment([p, q]) => {
+            let (s, w) = segment_triangle(p, q, a, b, c);
+            let anchor = p + (q - p) * s;
+            let gap = a * w[0] + b * w[1] + c * w[2] - anchor;
+            (gap.norm_squared() < within * within).then_some((anchor, w))
+        }
+        Feature::Circle(circle) => {
+            // The triangle's bounding sphere against the rim, before the exact search.
+            let centre = (a + b + c) / 3.0;
+            let radius = (a - centre)
+                .norm()
+                .max((b - centre).norm())
+                .max((c - centre).norm());
+            let d = centre - circle.center;
+            let axial = d.dot(&circle.axis);
+            let radial = (d - circle.axis * axial).norm() - circle.radius;
+            if radial * radial + axial * axial > (radius + within) * (radius + within) {
+                return None;
+            }
+            let (anchor, w) = circle_triangle(circle, a, b, c);
+            let gap = a * w[0] + b * w[1] + c * w[2] - anchor;
+            (gap.norm_squared() < within * within).then_some((anchor, w))
+        }
+    }
+}
+
+/// Whether `p` lies in the box.
+fn inside(p: &Vec3, (lo, hi): &(Vec3, Vec3)) -> bool {
+    (0..3).all(|k| lo[k] <= p[k] && p[k] <= hi[k])
+}
+
+/// Whether two boxes overlap.
+fn overlap((a0, a1): &(Vec3, Vec3), (b0, b1): &(Vec3, Vec3)) -> bool {
+    (0..3).all(|k| a0[k] <= b1[k] && b0[k] <= a1[k])
+}
+
+/// Whether particles `a` and `b` (both on active surfaces) collide: their surfaces differ
+/// or share self-collision; with the pair's thickness (the larger) and friction (the mean).
+fn pair(model: &Model, surface_of: &[u32], a: u32, b: u32) -> Option<(f64, f64)> {
+    let (sa, sb) = (surface_of[a as usize], surface_of[b as usize]);
+    let (s, t) = (&model.surfaces[sa as usize], &model.surfaces[sb as usize]);
+    if sa == sb && !s.self_collision {
+        return None;
+    }
+    Some((
+        s.thickness.max(t.thickness),
+        0.5 * (s.friction + t.friction),
+    ))
+}
+
+/// Whether `feature` can come within reach of a triangle whose reach-inflated box is `b`
+/// (a cheap test that spares the rims of a disc the triangles in its middle).
+fn near_feature(feature: &Feature, b: &(Vec3, Vec3)) -> bool {
+    match feature {
+        Feature::Segment(_) => true,
+        Feature::Circle(circle) => {
+            let centre = (b.0 + b.1) * 0.5;
+            let radius = 0.5 * (b.1 - b.0).norm();
+            let d = centre - circle.center;
+            let axial = d.dot(&circle.axis);
+            let radial = (d - circle.axis * axial).norm() - circle.radius;
+            radial * radial + axial * axial <= radius * radius
+        }
+    }
+}
+
+/// Runs the contact phase after an integrator step: `x0` are the step's start positions.
+/// Returns whether it may have moved any particle.
+pub(crate) fn resolve(
+    model: &Model,
+    p: &mut Particles,
+    x0: &[Vec3],
+    stuck: &mut [bool],
+    state: &mut ContactState,
+) -> bool {
+    let started = Instant::now();
+    if !state.ready {
+        state.prepare(model, p.len());
+    }
+    let moved = model.resolve_contacts(&p.inv_mass, &state.margin, x0, &mut p.x, &mut p.v, stuck);
+    if state.points.is_empty() {
+        state.stats.seconds += started.elapsed().as_secs_f64();
+        return moved;
+    }
+    state.refresh(model, &p.x);
+    state.active.clear();
+    state.detect(model, &p.x, x0);
+    for _ in 0..SWEEPS {
+        for s in &state.active {
+            let d = s.gap(&p.x).dot(&s.n);
+            if d >= s.h {
+                continue;
+            }
+            let c = s.compliance(&p.inv_mass);
+            if c == 0.0 {
+                continue;
+            }
+            s.spread(&p.inv_mass, &mut p.x, s.n * ((s.h - d) / c));
+            for k in 0..s.len {
+                let i = s.ids[k] as usize;
+                if s.w[k] != 0.0 && p.inv_mass[i] != 0.0 && !state.moved[i] {
+                    state.moved[i] = true;
+                    state.moved_list.push(s.ids[k]);
+                }
+            }
+        }
+    }
+    // Pushed particles may now be in a collider: their face contacts again, in order, so
+    // that a step always ends with every particle out of every collider.
+    state.moved_list.sort_unstable();
+    for &i in &state.moved_list {
+        let i = i as usize;
+        state.moved[i] = false;
+        if model.has_contact_responses() {
+            let (x, v) = (&mut p.x[i], &mut p.v[i]);
+            stuck[i] =
+                model.resolve_particle(p.inv_mass[i], state.margin[i], &x0[i], x, v, stuck[i]);
+        }
+    }
+    state.moved_list.clear();
+    for _ in 0..VELOCITY_SWEEPS {
+        for s in &state.active {
+            let c = s.compliance(&p.inv_mass);
+            if c == 0.0 {
+                continue;
+            }
+            let u = s.gap(&p.v) + s.anchor;
+            let un = u.dot(&s.n);
+            let ut = u - s.n * un;
+            let du = match s.rule {
+                Rule::Stop => -u,
+                _ if un >= 0.0 => continue,
+                Rule::Bounce { cr, keep } => s.n * (-(1.0 + cr) * un) + ut * (keep - 1.0),
+                Rule::Coulomb(mu) => {
+                    let t = ut.norm();
+                    let cut = if t > EPS {
+                        (mu * -un / t).min(1.0)
+                    } else {
+                        0.0
+                    };
+                    s.n * -un - ut * cut
+                }
+            };
+            s.spread(&p.inv_mass, &mut p.v, du / c);
+        }
+    }
+    state.stats.proximities = state.active.len();
+    state.stats.seconds += started.elapsed().as_secs_f64();
+    true
+}

@@ -1,0 +1,298 @@
+//! The contact model checked from outside: frames exported as OBJ files are read back with
+//! tobj, and no cloth triangle may cross a collider triangle or another cloth triangle it
+//! shares no corner with. The crossing test is written here from scratch (signed volumes),
+//! independent of the solver's proximity code.
+
+use crate::common::{builtin, root};
+use hooke_cli::obj_export::ObjExport;
+use hooke_core::{Integrator, Model, Particles, Simulation, Surface, Vec3, contact::ContactStats};
+use hooke_scene::Overrides;
+use std::path::{Path, PathBuf};
+
+type Tri = [Vec3; 3];
+
+/// `(b - a) × (c - a) · (d - a)`: positive when `d` is on the side the triangle `abc` faces.
+fn orient(a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3) -> f64 {
+    (b - a).cross(&(c - a)).dot(&(d - a))
+}
+
+/// Whether segment `pq` passes through the inside of triangle `t` (touching is not crossing:
+/// such configurations have measure zero, and the thickness keeps cloth far from them).
+fn segment_crosses(p: &Vec3, q: &Vec3, t: &Tri) -> bool {
+    let (sp, sq) = (
+        orient(&t[0], &t[1], &t[2], p),
+        orient(&t[0], &t[1], &t[2], q),
+    );
+    if !((sp > 0.0 && sq < 0.0) || (sp < 0.0 && sq > 0.0)) {
+        return false;
+    }
+    let e = [
+        orient(p, q, &t[0], &t[1]),
+        orient(p, q, &t[1], &t[2]),
+        orient(p, q, &t[2], &t[0]),
+    ];
+    e.iter().all(|&s| s > 0.0) || e.iter().all(|&s| s < 0.0)
+}
+
+/// Two triangles cross when an edge of one passes through the other.
+fn triangles_cross(a: &Tri, b: &Tri) -> bool {
+    (0..3).any(|k| segment_crosses(&a[k], &a[(k + 1) % 3], b))
+        || (0..3).any(|k| segment_crosses(&b[k], &b[(k + 1) % 3], a))
+}
+
+fn bounds(t: &Tri) -> (Vec3, Vec3) {
+    (t[0].inf(&t[1]).inf(&t[2]), t[0].sup(&t[1]).sup(&t[2]))
+}
+
+fn overlap(a: &(Vec3, Vec3), b: &(Vec3, Vec3)) -> bool {
+    (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
+}
+
+/// One exported frame: the cloth triangles with their corner indices, and the colliders'.
+struct Frame {
+    cloth: Vec<(Tri, [u32; 3])>,
+    colliders: Vec<Tri>,
+}
+
+fn read_frame(path: &Path) -> Frame {
+    let options = tobj::LoadOptions {
+        single_index: true,
+        triangulate: true,
+        ..tobj::LoadOptions::default()
+    };
+    let (models, _) = tobj::load_obj(path, &options).unwrap();
+    let mut frame = Frame {
+        cloth: Vec::new(),
+        colliders: Vec::new(),
+    };
+    for m in models {
+        let p = &m.mesh.positions;
+        let v = |i: u32| {
+            let i = 3 * i as usize;
+            Vec3::new(p[i], p[i + 1], p[i + 2])
+        };
+        for f in m.mesh.indices.chunks(3) {
+            let t = [v(f[0]), v(f[1]), v(f[2])];
+            if m.name.starts_with("body:") {
+                frame.cloth.push((t, [f[0], f[1], f[2]]));
+            } else {
+                assert!(m.name.starts_with("collider:"), "{}", m.name);
+                frame.colliders.push(t);
+            }
+        }
+    }
+    frame
+}
+
+/// Crossings in one frame: (cloth–collider, cloth–cloth) pair counts.
+fn crossings(frame: &Frame) -> (usize, usize) {
+    let cloth_boxes: Vec<_> = frame.cloth.iter().map(|(t, _)| bounds(t)).collect();
+    let mut against_colliders = 0;
+    for c in &frame.colliders {
+        let cb = bounds(c);
+        for (k, (t, _)) in frame.cloth.iter().enumerate() {
+            if overlap(&cb, &cloth_boxes[k]) && triangles_cross(t, c) {
+                against_colliders += 1;
+            }
+        }
+    }
+    // Cloth against cloth: a sweep along x over the boxes.
+    let mut order: Vec<usize> = (0..frame.cloth.len()).collect();
+    order.sort_by(|&a, &b| cloth_boxes[a].0.x.total_cmp(&cloth_boxes[b].0.x));
+    let mut among_cloth = 0;
+    for (i, &a) in order.iter().enumerate() {
+        for &b in &order[i + 1..] {
+            if cloth_boxes[b].0.x > cloth_boxes[a].1.x {
+                break;
+            }
+            let (ta, ia) = &frame.cloth[a];
+            let (tb, ib) = &frame.cloth[b];
+            if ia.iter().any(|v| ib.contains(v)) {
+                continue;
+            }
+            if overlap(&cloth_boxes[a], &cloth_boxes[b]) && triangles_cross(ta, tb) {
+                among_cloth += 1;
+            }
+        }
+    }
+    (against_colliders, among_cloth)
+}
+
+/// Runs built-in `name` to its end, exporting every frame into a fresh folder.
+fn export_run(name: &str, table: Option<&str>) -> (PathBuf, u64) {
+    let overrides = Overrides {
+        table: table.map(str::to_string),
+        ..Overrides::default()
+    };
+    let mut scene = builtin(name, &overrides);
+    let dir = std::env::temp_dir().join(format!(
+        "hooke-contact-{name}-{}-{}",
+        table.map_or("default".into(), |t| t.replace(['/', '.'], "_")),
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    let export = ObjExport::new(&dir, &scene).unwrap();
+    export.frame(0, &scene).unwrap();
+    let frames = scene.steps / scene.every;
+    for f in 1..=frames {
+        let every = scene.every;
+        scene.simulation.advance(every).unwrap();
+        export.frame(f, &scene).unwrap();
+    }
+    (dir, frames)
+}
+
+fn assert_no_crossings(name: &str, table: Option<&str>) {
+    let (dir, frames) = export_run(name, table);
+    let mut bad = Vec::new();
+    for f in 0..=frames {
+        let frame = read_frame(&dir.join(format!("frame-{f:05}.obj")));
+        assert!(!frame.cloth.is_empty() && !frame.colliders.is_empty());
+        let (c, s) = crossings(&frame);
+        if c + s > 0 {
+            bad.push(format!(
+                "frame {f}: {c} cloth-collider, {s} cloth-cloth crossings"
+            ));
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert!(
+        bad.is_empty(),
+        "{name} {table:?}: {} of {} frames cross:\n{}",
+        bad.len(),
+        frames + 1,
+        bad.join("\n")
+    );
+}
+
+#[test]
+fn cloth_on_the_round_mesh_table_never_crosses() {
+    assert_no_crossings("cloth-table", None);
+}
+
+#[test]
+fn cloth_on_the_analytic_cylinder_never_crosses() {
+    assert_no_crossings("cloth-table", Some("cylinder"));
+}
+
+#[test]
+fn cloth_on_the_square_table_never_crosses() {
+    let square = root().join("assets/meshes/square-table.obj");
+    assert_no_crossings("cloth-table", Some(square.to_str().unwrap()));
+}
+
+#[test]
+fn the_cloth_pile_never_crosses_itself_or_the_ground() {
+    assert_no_crossings("cloth-pile", None);
+}
+
+/// The checker itself: it sees two triangles through each other, and no crossing between
+/// parallel ones or ones apart.
+#[test]
+fn the_crossing_check_sees_crossings() {
+    let flat: Tri = [
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 1.0),
+    ];
+    let through: Tri = [
+        Vec3::new(0.2, -0.5, 0.2),
+        Vec3::new(0.2, 0.5, 0.2),
+        Vec3::new(0.3, 0.5, 0.3),
+    ];
+    let above = flat.map(|p| p + Vec3::new(0.0, 0.004, 0.0));
+    assert!(triangles_cross(&flat, &through));
+    assert!(!triangles_cross(&flat, &above));
+    assert!(!triangles_cross(
+        &above,
+        &through.map(|p| p + Vec3::new(5.0, 0.0, 0.0))
+    ));
+}
+
+/// Two particles' sheets: a 3-particle triangle at rest and one particle moving straight at
+/// its middle. After the step the particle is a thickness from the triangle, momentum is
+/// what it was, and kinetic energy did not grow.
+#[test]
+fn a_particle_against_a_sheet_keeps_the_thickness_momentum_and_no_new_energy() {
+    let h = 0.005;
+    let mut p = Particles::default();
+    for x in [
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(0.3, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 0.3),
+    ] {
+        p.push(x, Vec3::zeros(), 0.1);
+    }
+    // A second surface: one triangle far away, whose first corner heads for the sheet.
+    p.push(Vec3::new(0.1, 0.006, 0.1), Vec3::new(0.3, -2.0, 0.1), 0.05);
+    p.push(Vec3::new(0.1, 0.5, 0.1), Vec3::zeros(), 0.05);
+    p.push(Vec3::new(0.1, 0.5, 0.4), Vec3::zeros(), 0.05);
+    let surface = |range: std::ops::Range<usize>, tri: [u32; 3]| Surface {
+        particles: range,
+        triangles: vec![tri],
+        thickness: h,
+        self_collision: true,
+        friction: 0.3,
+    };
+    let model = Model {
+        surfaces: vec![surface(0..3, [0, 1, 2]), surface(3..6, [3, 4, 5])],
+        ..Model::default()
+    };
+    let momentum = |p: &Particles| {
+        p.v.iter()
+            .zip(&p.mass)
+            .fold(Vec3::zeros(), |m, (v, mass)| m + v * *mass)
+    };
+    let kinetic = |p: &Particles| {
+        p.v.iter()
+            .zip(&p.mass)
+            .map(|(v, m)| 0.5 * m * v.norm_squared())
+            .sum::<f64>()
+    };
+    let (m0, k0) = (momentum(&p), kinetic(&p));
+    let mut sim = Simulation::new(p, model, Integrator::Symplectic, 1e-3);
+    sim.step().unwrap();
+    let q = sim.particles();
+    // The particle ended the step on the sheet's side, a thickness from its (now slightly
+    // tilted) plane, to a micrometre.
+    let n = (q.x[1] - q.x[0]).cross(&(q.x[2] - q.x[0])).normalize();
+    let gap = (q.x[3] - q.x[0]).dot(&n).abs();
+    assert!(q.x[3].y > q.x[0].y, "the particle went through");
+    assert!((gap - h).abs() < 1e-6, "gap {gap}");
+    assert!(
+        (momentum(q) - m0).norm() < 1e-14,
+        "{} vs {}",
+        momentum(q),
+        m0
+    );
+    assert!(kinetic(q) < k0, "kinetic {} -> {}", k0, kinetic(q));
+    // They no longer approach each other: the sheet's velocity at the point under the
+    // particle matches the particle's along the normal.
+    let w = hooke_core::contact::proximity::point_triangle(&q.x[3], &q.x[0], &q.x[1], &q.x[2]);
+    let under = q.v[0] * w[0] + q.v[1] * w[1] + q.v[2] * w[2];
+    let closing = (q.v[3] - under).dot(&n);
+    assert!(closing > -1e-12, "{closing}");
+    let stats: ContactStats = sim.workspace().contact_stats();
+    assert!(stats.proximities >= 1);
+}
+
+/// A resting cloth lies a thickness above the ground, never on it: no z-fighting.
+#[test]
+fn cloth_rests_a_thickness_above_the_ground() {
+    let mut scene = builtin("cloth-pile", &Overrides::default());
+    let h = scene.bodies[0].thickness;
+    assert_eq!(h, hooke_core::DEFAULT_CLOTH_THICKNESS);
+    let steps = scene.steps;
+    scene.simulation.advance(steps).unwrap();
+    let lowest = scene
+        .simulation
+        .particles()
+        .x
+        .iter()
+        .map(|x| x.y)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        (lowest - h).abs() < 1e-4,
+        "lowest particle at {lowest} m, thickness {h} m"
+    );
+}
