@@ -54,6 +54,9 @@ pub enum Bench {
         /// Step size in seconds (default: the scene's).
         #[arg(long)]
         dt: Option<f64>,
+        /// Replace the table: an OBJ file, or `cylinder` for the analytic one.
+        #[arg(long, value_name = "FILE.obj|cylinder")]
+        table: Option<String>,
         /// Force-loop compilation (default: the widest this CPU runs).
         #[arg(long)]
         kernel: Option<Kernel>,
@@ -232,6 +235,7 @@ pub fn run(bench: &Bench) -> Result<ExitCode> {
             steps,
             integrator,
             dt,
+            table,
             kernel,
             threads,
             json,
@@ -239,6 +243,7 @@ pub fn run(bench: &Bench) -> Result<ExitCode> {
             let overrides = Overrides {
                 integrator: *integrator,
                 dt: *dt,
+                table: table.clone(),
                 ..Overrides::default()
             };
             pool(*threads)?.install(|| scene_steps(scene, &overrides, *kernel, *steps, *json))

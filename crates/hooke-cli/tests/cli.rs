@@ -423,3 +423,55 @@ fn bench_cloth_prints_the_workload_figures_as_json() {
         "centre fell {drop:e} m, a free particle {free_fall:e} m"
     );
 }
+
+#[test]
+fn export_obj_writes_a_frame_file_per_frame_with_named_objects() {
+    let dir = scratch("export-obj");
+    let o = hooke(
+        &[
+            "run",
+            "cloth-table",
+            "--table",
+            "cylinder",
+            "--steps",
+            "80",
+            "--every",
+            "40",
+            "--export-obj",
+            "objs",
+        ],
+        &dir,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut names = file_names(&dir.join("objs"));
+    names.sort();
+    assert_eq!(
+        names,
+        ["frame-00000.obj", "frame-00001.obj", "frame-00002.obj"]
+    );
+    let text = std::fs::read_to_string(dir.join("objs/frame-00002.obj")).unwrap();
+    let objects: Vec<&str> = text.lines().filter(|l| l.starts_with("o ")).collect();
+    assert_eq!(
+        objects,
+        [
+            "o body:cloth",
+            "o collider:0-ground",
+            "o collider:1-cylinder"
+        ]
+    );
+    // 32 × 32 cloth particles; 31 × 31 × 2 cloth triangles, 2 ground, 4 × 64 cylinder.
+    let count = |p: &str| text.lines().filter(|l| l.starts_with(p)).count();
+    assert_eq!(count("f "), 2 * 31 * 31 + 2 + 4 * 64);
+    assert_eq!(count("v "), 1024 + 3 * (2 + 4 * 64));
+
+    // A file where the folder should be: refused before anything runs.
+    std::fs::write(dir.join("taken"), "x").unwrap();
+    let o = hooke(&["run", "chain", "--export-obj", "taken"], &dir);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("is a file, expected a folder"),
+        "{}",
+        stderr(&o)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

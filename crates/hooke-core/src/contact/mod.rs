@@ -556,16 +556,7 @@ fn feature_gap(
             (gap.norm_squared() < within * within).then_some((anchor, w))
         }
         Feature::Circle(circle) => {
-            // The triangle's bounding sphere against the rim, before the exact search.
-            let centre = (a + b + c) / 3.0;
-            let radius = (a - centre)
-                .norm()
-                .max((b - centre).norm())
-                .max((c - centre).norm());
-            let d = centre - circle.center;
-            let axial = d.dot(&circle.axis);
-            let radial = (d - circle.axis * axial).norm() - circle.radius;
-            if radial * radial + axial * axial > (radius + within) * (radius + within) {
+            if circle.distance_bound(a, b, c) >= within {
                 return None;
             }
             let (anchor, w) = circle_triangle(circle, a, b, c);
