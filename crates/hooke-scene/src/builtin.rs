@@ -202,15 +202,14 @@ pub fn hanging_cloth() -> SceneSpec {
     }
 }
 
-/// A 32×32 cloth of 1.6 m square dropped flat onto the round table (`builtin:table.obj`, top
-/// radius 0.6 m at y = 1): particles touching the table stick, the edges hang down.
-pub fn cloth_table() -> SceneSpec {
-    let n = 32;
-    let side = 1.6;
-    let b = body(
+/// An `n × n` cloth of `side` metres square and `kg` in all, its corner at `origin`, with
+/// the table cloths' structural (300 N/m) and shear (150 N/m) springs and `bend` as
+/// `(ks, kd)`.
+fn square_cloth(n: usize, side: f64, kg: f64, origin: [f64; 3], bend: (f64, f64)) -> BodySpec {
+    body(
         "cloth",
-        0.4 / (n * n) as f64,
-        [-side / 2.0, 1.3, -side / 2.0],
+        kg / (n * n) as f64,
+        origin,
         ShapeSpec::Grid {
             size: [n, n],
             spacing: Positive(side / (n - 1) as f64),
@@ -218,9 +217,22 @@ pub fn cloth_table() -> SceneSpec {
         SpringsSpec {
             structural: params(300.0, 0.02),
             shear: params(150.0, 0.02),
-            bend: params(15.0, 0.005),
+            bend: params(bend.0, bend.1),
             pairs: Vec::new(),
         },
+    )
+}
+
+/// A 32×32 cloth of 1.6 m square dropped flat onto the round table (`builtin:table.obj`, top
+/// radius 0.6 m at y = 1): particles touching the table stick, the edges hang down.
+pub fn cloth_table() -> SceneSpec {
+    let side = 1.6;
+    let b = square_cloth(
+        32,
+        side,
+        0.4,
+        [-side / 2.0, 1.3, -side / 2.0],
+        (15.0, 0.005),
     );
     SceneSpec {
         name: "cloth-table".into(),
@@ -249,24 +261,9 @@ pub fn cloth_table() -> SceneSpec {
 /// lower edge just above the ground, then released: it buckles, folds over onto itself and
 /// settles into a pile, the case self-collision exists for.
 pub fn cloth_pile() -> SceneSpec {
-    let n = 32;
     let side = 1.2;
-    let mut b = body(
-        "cloth",
-        0.3 / (n * n) as f64,
-        // Rotated about x, the grid's local z runs up; its lowest row starts 2 cm up.
-        [-side / 2.0, 0.02, 0.0],
-        ShapeSpec::Grid {
-            size: [n, n],
-            spacing: Positive(side / (n - 1) as f64),
-        },
-        SpringsSpec {
-            structural: params(300.0, 0.02),
-            shear: params(150.0, 0.02),
-            bend: params(2.0, 0.002),
-            pairs: Vec::new(),
-        },
-    );
+    // Rotated about x, the grid's local z runs up; its lowest row starts 2 cm up.
+    let mut b = square_cloth(32, side, 0.3, [-side / 2.0, 0.02, 0.0], (2.0, 0.002));
     b.rotate = f3([-80.0, 0.0, 15.0]);
     SceneSpec {
         name: "cloth-pile".into(),
