@@ -97,19 +97,8 @@ struct Tunnelling {
 /// highest particle to the ground (or the lowest particle): what a falling cloth reaches.
 fn tunnelling(scene: &Scene) -> Vec<Tunnelling> {
     let sim = &scene.simulation;
-    let p = sim.particles();
     let model = sim.model();
-    let top = p.x.iter().map(|x| x.y).fold(f64::NEG_INFINITY, f64::max);
-    let mut bottom = p.x.iter().map(|x| x.y).fold(f64::INFINITY, f64::min);
-    for c in &scene.colliders {
-        if let hooke_scene::ColliderGeometry::Ground(h) = c {
-            bottom = bottom.min(*h);
-        }
-    }
-    let drop = (top - bottom).max(0.0);
-    let fall = (2.0 * model.gravity.norm() * drop).sqrt();
-    let now = p.v.iter().map(|v| v.norm()).fold(0.0, f64::max);
-    let speed = fall.max(now);
+    let (speed, drop) = fastest(scene);
     model
         .colliders
         .iter()
@@ -149,6 +138,49 @@ impl Tunnelling {
     }
 }
 
+/// The fastest a particle can move, m/s: the larger of the fastest now and a free fall from
+/// the highest particle to the ground (or the lowest particle); and that fall's height.
+fn fastest(scene: &Scene) -> (f64, f64) {
+    let sim = &scene.simulation;
+    let p = sim.particles();
+    let top = p.x.iter().map(|x| x.y).fold(f64::NEG_INFINITY, f64::max);
+    let mut bottom = p.x.iter().map(|x| x.y).fold(f64::INFINITY, f64::min);
+    for c in &scene.colliders {
+        if let hooke_scene::ColliderGeometry::Ground(h) = c {
+            bottom = bottom.min(*h);
+        }
+    }
+    let drop = (top - bottom).max(0.0);
+    let fall = (2.0 * sim.model().gravity.norm() * drop).sqrt();
+    let now = p.v.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    (fall.max(now), drop)
+}
+
+/// For each body with a contact thickness: a message when two of its layers, closing at
+/// twice the fastest speed, can cover the thickness in one step, so that a proximity is not
+/// seen before a crossing (`docs/physics.md` §3.3), with the largest safe step.
+fn thin_surfaces(scene: &Scene) -> Vec<String> {
+    let dt = scene.simulation.dt();
+    let (speed, _) = fastest(scene);
+    scene
+        .bodies
+        .iter()
+        .filter(|b| b.thickness > 0.0 && 2.0 * speed * dt > b.thickness)
+        .map(|b| {
+            format!(
+                "body '{}': two layers closing at {:.2} m/s move {:.1} mm per step of {dt} s, more \
+                 than its contact thickness of {:.1} mm, so they can cross unseen; use dt below \
+                 {:.3e} s or a larger thickness",
+                b.name,
+                2.0 * speed,
+                2.0 * speed * dt * 1e3,
+                b.thickness * 1e3,
+                b.thickness / (2.0 * speed)
+            )
+        })
+        .collect()
+}
+
 /// Warns on stderr about thin colliders a particle can cross in one step.
 fn warn_if_tunnelling(scene: &Scene) {
     let dt = scene.simulation.dt();
@@ -159,6 +191,9 @@ fn warn_if_tunnelling(scene: &Scene) {
             t.describe(dt),
             t.safe_dt
         );
+    }
+    for message in thin_surfaces(scene) {
+        eprintln!("warning: {message}");
     }
 }
 
@@ -320,6 +355,9 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
                 t.safe_dt
             );
         }
+    }
+    for message in thin_surfaces(&scene) {
+        println!("warning: tunnelling: {message}");
     }
     Ok(ExitCode::SUCCESS)
 }
