@@ -105,12 +105,9 @@ impl Model {
         for slot in &self.colliders {
             if slot.response.is_force() {
                 let m = *margin.get_or_insert_with(|| self.margin(p));
-                let mut add = |c: Contact| f += slot.response.penalty_force(&c, v);
-                if m == 0.0 {
-                    slot.shape.contacts(x, &mut add);
-                } else {
-                    slot.shape.contacts_within(x, m, &mut add);
-                }
+                slot.shape.contacts_within(x, m, &mut |c: Contact| {
+                    f += slot.response.penalty_force(&c, v)
+                });
             }
         }
         f
@@ -186,11 +183,8 @@ impl Model {
                 touched = true;
                 slot.response.resolve(&c, x, v);
             };
-            if margin == 0.0 {
-                slot.shape.contacts(&here, &mut apply);
-            } else {
-                slot.shape.contacts_within(&here, margin, &mut apply);
-            }
+            // With no margin this is `contacts`, the Collider contract says.
+            slot.shape.contacts_within(&here, margin, &mut apply);
             if !touched && let Some(mut c) = slot.shape.crossing(x0, &here) {
                 touched = true;
                 c.depth += margin;

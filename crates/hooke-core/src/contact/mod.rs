@@ -148,8 +148,6 @@ pub struct ContactStats {
     pub proximities: usize,
     /// Candidate pairs in the current lists.
     pub candidates: usize,
-    /// Of the rebuilds, those of the surface pairs (the rest rebuilt the feature pairs only).
-    pub surface_rebuilds: u64,
 }
 
 /// A triangle near a collider feature.
@@ -191,8 +189,8 @@ pub(crate) struct ContactState {
     /// Per-chunk buffers of the parallel detection and candidate builds.
     scratch: Vec<Vec<Stencil>>,
     pair_scratch: Vec<Vec<[u32; 2]>>,
-    moved: Vec<bool>,
-    moved_list: Vec<u32>,
+    /// Particles the position sweeps moved.
+    moved: Vec<u32>,
     pub(crate) stats: ContactStats,
 }
 
@@ -224,13 +222,6 @@ impl ContactState {
         // Half a skin of travel between builds: a cloth falling a few metres a second
         // rebuilds every few steps, a resting one never.
         self.skin = 2.0 * self.h_max;
-        self.moved = vec![false; n];
-    }
-
-    /// Whether particles `a` and `b`'s surfaces collide, and with what thickness and
-    /// friction.
-    fn pair(&self, model: &Model, a: u32, b: u32) -> Option<(f64, f64)> {
-        pair(model, &self.surface_of, a, b)
     }
 
     /// The largest displacement of a surface particle from `x_ref`, measured from `shift`
@@ -265,7 +256,6 @@ impl ContactState {
         self.stats.rebuilds += 1;
         self.bin(x);
         if self_stale {
-            self.stats.surface_rebuilds += 1;
             self.self_ref.clear();
             self.self_ref.extend_from_slice(x);
             self.build_surface_pairs(model, x);
@@ -326,7 +316,8 @@ impl ContactState {
         let (edges, edge_box, edge_grid) = (&self.edges, &self.edge_box, &self.edge_grid);
 
         // Particle against triangle: the triangle's low cell is the particle's or one below.
-        par_fill(&self.points, &mut scratch, |&p, out| {
+        par_fill(self.points.len(), &mut scratch, |i, out| {
+            let p = self.points[i];
             let xp = x[p as usize];
             let c = tri_grid.cell_of(&xp);
             for d in 0..8 {
@@ -351,8 +342,8 @@ impl ContactState {
 
         // Edge against edge: each pair once, from its lower edge, over the edge's own cell
         // and the 13 neighbours of one half-space (the other 13 see it from theirs).
-        let ids: Vec<u32> = (0..edges.len() as u32).collect();
-        par_fill(&ids, &mut scratch, |&e, out| {
+        par_fill(edges.len(), &mut scratch, |e, out| {
+            let e = e as u32;
             let c = edge_grid.item_cell(e);
             let ee = edges[e as usize];
             for d in 13..27 {
@@ -412,7 +403,6 @@ impl ContactState {
                         self.tri_grid.visit([i, j, k], |t| {
                             let b = &boxes[t as usize];
                             if overlap(b, &(flo, fhi))
-                                && near_feature(&feature, b)
                                 && feature_gap(&feature, &tris[t as usize], x, reach).is_some()
                             {
                                 pairs.push(FeaturePair {
@@ -439,7 +429,8 @@ impl ContactState {
                 out.push(s);
             }
         };
-        par_fill(&self.feature_pairs, &mut scratch, |pair, out| {
+        par_fill(self.feature_pairs.len(), &mut scratch, |i, out| {
+            let pair = &self.feature_pairs[i];
             let t = self.tris[pair.tri as usize];
             let h = self.margin[t[0] as usize];
             if let Some((anchor, w)) = feature_gap(&pair.feature, &t, x, h) {
@@ -456,9 +447,10 @@ impl ContactState {
             }
         });
         append(&mut self.active, &scratch);
-        par_fill(&self.point_tri, &mut scratch, |&[p, t], out| {
+        par_fill(self.point_tri.len(), &mut scratch, |i, out| {
+            let [p, t] = self.point_tri[i];
             let tri = self.tris[t as usize];
-            let Some((h, mu)) = self.pair(model, p, tri[0]) else {
+            let Some((h, mu)) = pair(model, &self.surface_of, p, tri[0]) else {
                 return;
             };
             let [ia, ib, ic] = tri.map(|i| i as usize);
@@ -475,9 +467,10 @@ impl ContactState {
             keep(s, out);
         });
         append(&mut self.active, &scratch);
-        par_fill(&self.edge_edge, &mut scratch, |&[e, f], out| {
+        par_fill(self.edge_edge.len(), &mut scratch, |i, out| {
+            let [e, f] = self.edge_edge[i];
             let (ee, ef) = (self.edges[e as usize], self.edges[f as usize]);
-            let Some((h, mu)) = self.pair(model, ee[0], ef[0]) else {
+            let Some((h, mu)) = pair(model, &self.surface_of, ee[0], ef[0]) else {
                 return;
             };
             let [a, b] = ee.map(|i| x[i as usize]);
@@ -505,28 +498,28 @@ const CHUNKS: usize = 8;
 /// Fewer candidates than this are not worth a parallel pass.
 const PARALLEL_MIN: usize = 512;
 
-/// Calls `f(item, out)` for every item, filling `bufs` (one per chunk of consecutive
-/// items, [`CHUNKS`] of them) in parallel; reading the buffers in order gives what a
+/// Calls `f(i, out)` for every `i < n`, filling `bufs` (one per chunk of consecutive
+/// indices, [`CHUNKS`] of them) in parallel; reading the buffers in order gives what a
 /// sequential pass would have pushed.
-fn par_fill<T: Sync, U: Send>(
-    items: &[T],
+fn par_fill<U: Send>(
+    n: usize,
     bufs: &mut Vec<Vec<U>>,
-    f: impl Fn(&T, &mut Vec<U>) + Sync + Send,
+    f: impl Fn(usize, &mut Vec<U>) + Sync + Send,
 ) {
     bufs.resize_with(CHUNKS, Vec::new);
     for b in bufs.iter_mut() {
         b.clear();
     }
-    if items.len() < PARALLEL_MIN {
-        for item in items {
-            f(item, &mut bufs[0]);
+    if n < PARALLEL_MIN {
+        for i in 0..n {
+            f(i, &mut bufs[0]);
         }
         return;
     }
-    let per = items.len().div_ceil(CHUNKS);
+    let per = n.div_ceil(CHUNKS);
     bufs.par_iter_mut().enumerate().for_each(|(k, out)| {
-        for item in items.iter().skip(k * per).take(per) {
-            f(item, out);
+        for i in (k * per).min(n)..((k + 1) * per).min(n) {
+            f(i, out);
         }
     });
 }
@@ -548,22 +541,16 @@ fn feature_gap(
     within: f64,
 ) -> Option<(Vec3, [f64; 3])> {
     let (a, b, c) = (&x[t[0] as usize], &x[t[1] as usize], &x[t[2] as usize]);
-    match feature {
+    let (anchor, w) = match feature {
         Feature::Segment([p, q]) => {
             let (s, w) = segment_triangle(p, q, a, b, c);
-            let anchor = p + (q - p) * s;
-            let gap = a * w[0] + b * w[1] + c * w[2] - anchor;
-            (gap.norm_squared() < within * within).then_some((anchor, w))
+            (p + (q - p) * s, w)
         }
-        Feature::Circle(circle) => {
-            if circle.distance_bound(a, b, c) >= within {
-                return None;
-            }
-            let (anchor, w) = circle_triangle(circle, a, b, c);
-            let gap = a * w[0] + b * w[1] + c * w[2] - anchor;
-            (gap.norm_squared() < within * within).then_some((anchor, w))
-        }
-    }
+        Feature::Circle(circle) if circle.distance_bound(a, b, c) >= within => return None,
+        Feature::Circle(circle) => circle_triangle(circle, a, b, c),
+    };
+    let gap = a * w[0] + b * w[1] + c * w[2] - anchor;
+    (gap.norm_squared() < within * within).then_some((anchor, w))
 }
 
 /// Whether `p` lies in the box.
@@ -588,22 +575,6 @@ fn pair(model: &Model, surface_of: &[u32], a: u32, b: u32) -> Option<(f64, f64)>
         s.thickness.max(t.thickness),
         0.5 * (s.friction + t.friction),
     ))
-}
-
-/// Whether `feature` can come within reach of a triangle whose reach-inflated box is `b`
-/// (a cheap test that spares the rims of a disc the triangles in its middle).
-fn near_feature(feature: &Feature, b: &(Vec3, Vec3)) -> bool {
-    match feature {
-        Feature::Segment(_) => true,
-        Feature::Circle(circle) => {
-            let centre = (b.0 + b.1) * 0.5;
-            let radius = 0.5 * (b.1 - b.0).norm();
-            let d = centre - circle.center;
-            let axial = d.dot(&circle.axis);
-            let radial = (d - circle.axis * axial).norm() - circle.radius;
-            radial * radial + axial * axial <= radius * radius
-        }
-    }
 }
 
 /// Runs the contact phase after an integrator step: `x0` are the step's start positions.
@@ -638,28 +609,25 @@ pub(crate) fn resolve(
                 continue;
             }
             s.spread(&p.inv_mass, &mut p.x, s.n * ((s.h - d) / c));
-            for k in 0..s.len {
-                let i = s.ids[k] as usize;
-                if s.w[k] != 0.0 && p.inv_mass[i] != 0.0 && !state.moved[i] {
-                    state.moved[i] = true;
-                    state.moved_list.push(s.ids[k]);
-                }
-            }
+            let moved = (0..s.len)
+                .filter(|&k| s.w[k] != 0.0 && p.inv_mass[s.ids[k] as usize] != 0.0)
+                .map(|k| s.ids[k]);
+            state.moved.extend(moved);
         }
     }
-    // Pushed particles may now be in a collider: their face contacts again, in order, so
-    // that a step always ends with every particle out of every collider.
-    state.moved_list.sort_unstable();
-    for &i in &state.moved_list {
-        let i = i as usize;
-        state.moved[i] = false;
-        if model.has_contact_responses() {
+    // Pushed particles may now be in a collider: their face contacts again, once each and
+    // in order, so that a step always ends with every particle out of every collider.
+    if model.has_contact_responses() {
+        state.moved.sort_unstable();
+        state.moved.dedup();
+        for &i in &state.moved {
+            let i = i as usize;
             let (x, v) = (&mut p.x[i], &mut p.v[i]);
             stuck[i] =
                 model.resolve_particle(p.inv_mass[i], state.margin[i], &x0[i], x, v, stuck[i]);
         }
     }
-    state.moved_list.clear();
+    state.moved.clear();
     for _ in 0..VELOCITY_SWEEPS {
         for s in &state.active {
             let c = s.compliance(&p.inv_mass);
