@@ -147,13 +147,7 @@ fn no_cloth_particle_ends_up_inside_the_table_top() {
     }
     // The middle of the cloth lies on the top: about π R² / h² = 420 particles.
     assert!(on_top > 250, "only {on_top} particles rest on the top");
-    let lowest = scene
-        .simulation
-        .particles()
-        .x
-        .iter()
-        .map(|x| x.y)
-        .fold(f64::INFINITY, f64::min);
+    let lowest = crate::common::lowest(&scene);
     assert!(
         lowest < round::TOP_Y - 0.3,
         "the edges should hang down; lowest particle at {lowest}"
@@ -268,7 +262,7 @@ fn implicit_cloth_stays_on_the_table_at_twenty_times_the_symplectic_step() {
         .filter(|p| (p.x * p.x + p.z * p.z).sqrt() < 0.59 && (0.961..0.999).contains(&p.y))
         .count();
     assert_eq!(inside, 0, "particles inside the tabletop");
-    let lowest = x.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
+    let lowest = crate::common::lowest(&scene);
     assert!(
         lowest > 0.3,
         "the edges hang, they do not fall: lowest y = {lowest}"

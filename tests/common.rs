@@ -29,6 +29,12 @@ pub fn builtin(name: &str, overrides: &Overrides) -> Scene {
     spec.build(&root().join("assets/scenes")).unwrap()
 }
 
+/// The height of the lowest particle of `scene`, metres.
+pub fn lowest(scene: &Scene) -> f64 {
+    let x = &scene.simulation.particles().x;
+    x.iter().map(|p| p.y).fold(f64::INFINITY, f64::min)
+}
+
 /// Magnitudes below this (a nanometre, a nanojoule, a nanometre per second) are round-off
 /// left by cancellation, such as the z of a particle on a plane of symmetry, not physics.
 pub const NOISE_FLOOR: f64 = 1e-9;

@@ -284,13 +284,7 @@ fn cloth_rests_a_thickness_above_the_ground() {
     assert_eq!(h, hooke_core::DEFAULT_CLOTH_THICKNESS);
     let steps = scene.steps;
     scene.simulation.advance(steps).unwrap();
-    let lowest = scene
-        .simulation
-        .particles()
-        .x
-        .iter()
-        .map(|x| x.y)
-        .fold(f64::INFINITY, f64::min);
+    let lowest = crate::common::lowest(&scene);
     assert!(
         (lowest - h).abs() < 1e-4,
         "lowest particle at {lowest} m, thickness {h} m"
