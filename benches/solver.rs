@@ -1,6 +1,6 @@
 //! Solver benches: one force evaluation, the spring loop in each compilation the CPU runs,
 //! and one step of each integrator, on the cloth-N workload
-//! (`shared/bench/cloth-workload.md`) and on a public jello world.
+//! (`docs/benchmarks.md`) and on a public jello world.
 //!
 //! `cargo bench -p hooke-tests --bench solver`; figures in `benches/README.md`.
 

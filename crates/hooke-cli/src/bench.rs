@@ -20,7 +20,7 @@ use std::time::Instant;
 /// What `hooke bench` measures.
 #[derive(clap::Subcommand)]
 pub enum Bench {
-    /// The cloth-N workload (shared/bench/cloth-workload.md): steps/s and spring updates/s.
+    /// The cloth-N workload (docs/benchmarks.md): steps/s and spring updates/s.
     Cloth {
         /// Particles along each side.
         #[arg(long, default_value_t = 256)]

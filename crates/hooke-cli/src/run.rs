@@ -236,7 +236,7 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
             e.frame(frame, scene)?;
         }
         let sim = &scene.simulation;
-        // SPEC §6: the time of frame f is (f K) dt computed as one product.
+        // docs/physics.md §6: the time of frame f is (f K) dt computed as one product.
         let time = (frame * every) as f64 * dt;
         if let Some(t) = trajectory.as_mut() {
             t.frame(frame, time, sim.particles())?;

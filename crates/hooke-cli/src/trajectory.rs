@@ -1,4 +1,4 @@
-//! Trajectory CSV (SPEC §6): `frame,time,particle,x,y,z,vx,vy,vz`, numbers in Rust's
+//! Trajectory CSV (docs/physics.md §6): `frame,time,particle,x,y,z,vx,vy,vz`, numbers in Rust's
 //! shortest round-trip form.
 
 use crate::output::AtomicFile;

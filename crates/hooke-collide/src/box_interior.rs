@@ -4,7 +4,7 @@ use hooke_core::{Collider, Contact, Vec3};
 
 /// Particles must stay inside `[min, max]`; every coordinate strictly beyond a face is a
 /// violation of that face, with the excess as depth and the normal pointing into the box.
-/// A corner violates up to three faces at once and reports each (SPEC §1: each violated face
+/// A corner violates up to three faces at once and reports each (docs/physics.md §1: each violated face
 /// adds its own penalty term).
 ///
 /// ```

@@ -1,7 +1,7 @@
 //! # hooke-collide: the shapes particles collide with
 //!
 //! Implementations of [`hooke_core::Collider`] for the colliders of the physics contract
-//! (`shared/SPEC.md` §2):
+//! (`docs/physics.md` §2):
 //!
 //! | shape | type | inside when |
 //! |---|---|---|

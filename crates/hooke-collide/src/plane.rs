@@ -1,4 +1,4 @@
-//! Planes: the ground `y = h0` and the inclined plane `a x + b y + c z + d = 0` (SPEC §2).
+//! Planes: the ground `y = h0` and the inclined plane `a x + b y + c z + d = 0` (docs/physics.md §2).
 
 use hooke_core::{Collider, Contact, Vec3};
 
@@ -7,8 +7,8 @@ use hooke_core::{Collider, Contact, Vec3};
 /// With `f(x) = a x + b y + c z + d` and the free side `s` (`+1` or `-1`), a point is inside
 /// when `s f(x) < 0`; its depth is `-s f(x) / |(a, b, c)|` and the outward normal
 /// `s (a, b, c) / |(a, b, c)|`. These are the formulas of the contract, evaluated as written,
-/// rather than parry's `HalfSpace`, so that jello worlds match other implementations of SPEC
-/// to the last bit.
+/// rather than parry's `HalfSpace`, so that jello worlds match other implementations of the
+/// contract (docs/physics.md §2) to the last bit.
 ///
 /// ```
 /// use hooke_collide::Plane;
@@ -35,7 +35,7 @@ impl Plane {
     }
 
     /// The plane `a x + b y + c z + d = 0` whose free side is the one holding `free_point`
-    /// (SPEC §2: the body's initial centroid; a centroid on the plane counts as `+1`).
+    /// (docs/physics.md §2: the body's initial centroid; a centroid on the plane counts as `+1`).
     /// `None` when `(a, b, c)` is zero or a coefficient is not finite.
     pub fn inclined(coefficients: [f64; 4], free_point: &Vec3) -> Option<Self> {
         let [a, b, c, _] = coefficients;

@@ -41,7 +41,7 @@ impl Feature {
     }
 }
 
-/// A solid (or thin) obstacle that particles must stay out of (SPEC §2).
+/// A solid (or thin) obstacle that particles must stay out of (docs/physics.md §2).
 ///
 /// Implementors answer point queries; the responses (penalty, restitution, stick) are the
 /// core's, so a collider never touches velocities.

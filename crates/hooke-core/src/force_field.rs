@@ -1,4 +1,4 @@
-//! A force field sampled on a regular grid over `[-2, 2]^3` (SPEC §1, the jello course).
+//! A force field sampled on a regular grid over `[-2, 2]^3` (docs/physics.md §1, the jello course).
 
 use crate::particles::Vec3;
 

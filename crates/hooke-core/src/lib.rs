@@ -1,7 +1,7 @@
 //! # hooke-core: the mass-spring solver
 //!
 //! Particles as flat arrays, springs as index pairs, the forces of the physics contract
-//! (`shared/SPEC.md` §1: damped springs, gravity, a force field on a grid, penalty springs),
+//! (`docs/physics.md` §1: damped springs, gravity, a force field on a grid, penalty springs),
 //! four integrators (§4) and the three collision responses (§3). Units are SI throughout:
 //! metres, seconds, kilograms, newtons; scenes are +Y up.
 //!

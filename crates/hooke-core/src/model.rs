@@ -19,7 +19,7 @@ pub struct ColliderSlot {
 
 /// Springs, external forces and colliders, and the per-particle masses they act on.
 ///
-/// Forces are evaluated per SPEC §1 by an [`crate::Assembly`], which sums them in an order
+/// Forces are evaluated per docs/physics.md §1 by an [`crate::Assembly`], which sums them in an order
 /// fixed by the problem, so results are the same bits however the work is split.
 #[derive(Debug, Default)]
 pub struct Model {
@@ -36,7 +36,7 @@ pub struct Model {
     /// Particles tied to points in space, such as a particle grabbed with the mouse.
     pub attachments: Vec<Attachment>,
     /// The bodies' surfaces that take part in contacts (see [`crate::contact`]); empty for
-    /// systems of bare particles, whose contacts are SPEC's per-particle tests alone.
+    /// systems of bare particles, whose contacts are the per-particle tests of docs/physics.md §3.3 alone.
     pub surfaces: Vec<Surface>,
 }
 

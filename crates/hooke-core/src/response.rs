@@ -1,4 +1,4 @@
-//! Collision responses (SPEC §3): what happens to a particle a collider reports.
+//! Collision responses (docs/physics.md §3.3): what happens to a particle a collider reports.
 
 use crate::collider::Contact;
 use crate::particles::Vec3;

@@ -11,7 +11,7 @@ use crate::stability::StabilityEstimate;
 /// is larger than a few metres, and an explicit blow-up passes this bound within a few steps.
 pub const SANE_BOUND: f64 = 1.0e6;
 
-/// A run stopped because the state stopped making sense (SPEC §7).
+/// A run stopped because the state stopped making sense (docs/physics.md §7).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error(
     "diverged at step {step} (t = {time} s): particle {particle} {what}; \

@@ -1,4 +1,4 @@
-//! Springs: index pairs with rest length, stiffness and damping (SPEC §1).
+//! Springs: index pairs with rest length, stiffness and damping (docs/physics.md §1).
 
 use crate::particles::Vec3;
 
@@ -47,11 +47,11 @@ pub struct Spring {
     pub kind: SpringKind,
 }
 
-/// Below this length a spring has no direction and adds no force (SPEC §1).
+/// Below this length a spring has no direction and adds no force (docs/physics.md §1).
 pub const DEGENERATE_LENGTH: f64 = 1e-12;
 
 impl Spring {
-    /// The force on particle `i` (particle `j` receives its negation), exactly as SPEC §1:
+    /// The force on particle `i` (particle `j` receives its negation), exactly as docs/physics.md §1:
     /// `-ks (L - l) u - kd ((v_i - v_j) · u) u` with `u = (x_i - x_j) / L`.
     ///
     /// ```
@@ -73,7 +73,7 @@ impl Spring {
     }
 }
 
-/// The force on the `i` end of a spring from `d = x_i - x_j` and `dv = v_i - v_j` (SPEC §1):
+/// The force on the `i` end of a spring from `d = x_i - x_j` and `dv = v_i - v_j` (docs/physics.md §1):
 /// `(-ks (|d| - rest) - kd dv·u) u` with `u = d / |d|`; zero for a degenerate spring. Every
 /// force path goes through [`spring_formula`], so they agree to the bit.
 #[inline]
@@ -87,7 +87,7 @@ pub(crate) fn spring_force(d: Vec3, dv: Vec3, rest: f64, ks: f64, kd: f64) -> Ve
     ))
 }
 
-/// SPEC §1's spring force, the one copy of the formula: every batch layout and
+/// docs/physics.md §1's spring force, the one copy of the formula: every batch layout and
 /// [`spring_force`] inline it, so all give the same bits. It has no branch (the degenerate
 /// case is a select after the division), so a loop of it vectorises at the target's full
 /// width: square roots and divisions, the bottleneck of a spring, then run several springs

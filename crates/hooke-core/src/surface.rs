@@ -14,7 +14,7 @@ pub const DEFAULT_SURFACE_FRICTION: f64 = 0.3;
 /// One body's surface: its triangles, how far other things keep from it, and whether it
 /// collides with itself.
 ///
-/// A surface with zero thickness takes part in no contact beyond SPEC's per-particle
+/// A surface with zero thickness takes part in no contact beyond the per-particle
 /// collider tests (the jello worlds), so adding one changes nothing.
 ///
 /// ```

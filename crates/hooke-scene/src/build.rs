@@ -94,7 +94,7 @@ pub struct Body {
     pub topology: Topology,
     /// Surface triangles as simulation particle indices (empty for chains and points).
     pub triangles: Vec<[u32; 3]>,
-    /// Contact thickness of the surface, metres (zero: SPEC's bare particle contacts).
+    /// Contact thickness of the surface, metres (zero: bare per-particle contacts, docs/physics.md §3.3).
     pub thickness: f64,
 }
 

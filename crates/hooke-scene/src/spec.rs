@@ -209,7 +209,7 @@ pub struct BodySpec {
     /// Contact thickness in metres: colliders and other surfaces are kept this far from the
     /// body's particles and triangles (`docs/physics.md` §3). Default: 5 mm for a `grid`
     /// (cloth), capped at a quarter of its spacing; 0 for other shapes, whose contacts are
-    /// then exactly SPEC's per-particle tests. Chains and points have no surface.
+    /// then exactly the per-particle tests of docs/physics.md §3.3. Chains and points have no surface.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thickness: Option<NonNegative>,
     /// Whether the body's surface collides with itself (default: on when it has a
@@ -370,7 +370,7 @@ fn unit() -> [Positive; 3] {
     [Positive(1.0); 3]
 }
 
-/// A collision response (SPEC §3).
+/// A collision response (docs/physics.md §3.3).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum ResponseSpec {

@@ -1,4 +1,4 @@
-//! The cloth-N benchmark workload (`shared/bench/cloth-workload.md`), as a scene.
+//! The cloth-N benchmark workload (`docs/benchmarks.md`), as a scene.
 
 use crate::spec::*;
 use hooke_core::Integrator;

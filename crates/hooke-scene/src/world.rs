@@ -1,4 +1,4 @@
-//! Jello worlds: the `.w` text format of the USC CSCI 520 jello cube (SPEC §5).
+//! Jello worlds: the `.w` text format of the USC CSCI 520 jello cube (docs/physics.md §5).
 //!
 //! ```text
 //! RK4 | Euler                    integrator (any case)
@@ -26,7 +26,7 @@ use std::path::{Path, PathBuf};
 pub const SIDE: usize = 8;
 /// Points of the jello cube.
 pub const POINTS: usize = SIDE * SIDE * SIDE;
-/// Spacing of the undeformed cube of side 1 (SPEC §5: rest lengths come from it).
+/// Spacing of the undeformed cube of side 1 (docs/physics.md §5: rest lengths come from it).
 pub const SPACING: f64 = 1.0 / 7.0;
 /// Steps run when neither the command line nor the world says how long to run.
 pub const DEFAULT_STEPS: u64 = 1000;
@@ -367,7 +367,7 @@ impl World {
                     bend: springs,
                     pairs: Vec::new(),
                 },
-                // SPEC §5: a world's jelly has SPEC's bare per-particle contacts.
+                // docs/physics.md §5: a world's jelly has SPEC's bare per-particle contacts.
                 thickness: None,
                 self_collision: None,
                 friction: None,
@@ -417,7 +417,7 @@ impl World {
             return no("jello worlds have no pinned points");
         }
         if body.thickness.is_some_and(|h| h.0 != 0.0) {
-            return no("jello worlds have no contact thickness (SPEC's per-particle contacts)");
+            return no("jello worlds have no contact thickness (bare per-particle contacts)");
         }
         let mut penalty = None;
         let mut has_box = false;

@@ -1,4 +1,4 @@
-//! Time integrators (SPEC §4), all sharing one force evaluator and one reusable workspace.
+//! Time integrators (docs/physics.md §4), all sharing one force evaluator and one reusable workspace.
 //!
 //! Every scheme advances the state `s = (x, v)` with `a(s) = F(s) / m`. Velocity-level
 //! collision responses are not the integrator's business: [`crate::Simulation`] applies them
@@ -37,7 +37,7 @@ pub enum Integrator {
 }
 
 impl Integrator {
-    /// All integrators, in the order of SPEC §4.
+    /// All integrators, in the order of docs/physics.md §4.
     pub const ALL: [Integrator; 5] = [
         Self::Euler,
         Self::Symplectic,
