@@ -12,11 +12,12 @@ use crate::stability::StabilityEstimate;
 pub const SANE_BOUND: f64 = 1.0e6;
 
 /// A run stopped because the state stopped making sense (docs/physics.md §7).
+///
+/// Its message names the step, the time, the particle and a step size expected to be
+/// stable, and says whether the step in use exceeds the stability estimate or not (when it
+/// does not, the step size alone does not explain the divergence).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error(
-    "diverged at step {step} (t = {time} s): particle {particle} {what}; \
-     the {integrator} step dt = {dt} s exceeds the stable estimate, try --dt {suggested_dt:.3e} or smaller"
-)]
+#[error("{}", self.message())]
 pub struct Divergence {
     /// The step that produced the bad state (1-based: the first step is step 1).
     pub step: u64,
@@ -30,8 +31,51 @@ pub struct Divergence {
     pub integrator: Integrator,
     /// The step size in use.
     pub dt: f64,
-    /// A step size expected to be stable (half the estimated limit, for margin).
+    /// The integrator's estimated stable step at the step's start, seconds (infinite for
+    /// the implicit integrator and for systems without springs).
+    pub stable_dt: f64,
+    /// A step size expected to be stable: half the estimate, or half the step in use when
+    /// that is smaller (the estimate did not explain the divergence, so take margin).
     pub suggested_dt: f64,
+}
+
+impl Divergence {
+    fn message(&self) -> String {
+        use crate::Num;
+        let head = format!(
+            "diverged at step {} (t = {} s): particle {} {}",
+            self.step,
+            Num(self.time),
+            self.particle,
+            self.what
+        );
+        let advice = if self.dt > self.stable_dt {
+            format!(
+                "the {} step dt = {} s exceeds its stable estimate of {:.3e} s; use dt = {:.3e} s \
+                 or smaller",
+                self.integrator,
+                Num(self.dt),
+                self.stable_dt,
+                self.suggested_dt
+            )
+        } else {
+            let estimate = if self.stable_dt.is_finite() {
+                format!("its stable estimate of {:.3e} s", self.stable_dt)
+            } else {
+                "its stable estimate (any dt)".to_string()
+            };
+            format!(
+                "the {} step dt = {} s is within {estimate}, so the step size alone does not \
+                 explain this: look for a very stiff or degenerate spring, a stiff penalty \
+                 collider, a strong force field or an extreme initial state; a smaller step, \
+                 dt = {:.3e} s, may still help",
+                self.integrator,
+                Num(self.dt),
+                self.suggested_dt
+            )
+        };
+        format!("{head}; {advice}")
+    }
 }
 
 /// A mass-spring system being simulated.
@@ -206,7 +250,15 @@ impl Simulation {
                         }
                     }
                 }
-                let limit = StabilityEstimate::of(&self.model, &at_start).max_dt(self.integrator);
+                // A state that already overflowed has no geometry to linearise at: bound the
+                // frequency from the springs' stiffness and the masses alone.
+                let finite = at_start.x.iter().all(|x| x.iter().all(|c| c.is_finite()));
+                let estimate = if finite {
+                    StabilityEstimate::of(&self.model, &at_start)
+                } else {
+                    StabilityEstimate::bound(&self.model, &at_start)
+                };
+                let stable_dt = estimate.max_dt(self.integrator);
                 Err(Divergence {
                     step: self.step,
                     time: self.time(),
@@ -214,7 +266,8 @@ impl Simulation {
                     what,
                     integrator: self.integrator,
                     dt: self.dt,
-                    suggested_dt: 0.5 * limit.min(self.dt),
+                    stable_dt,
+                    suggested_dt: 0.5 * stable_dt.min(self.dt),
                 })
             }
         }

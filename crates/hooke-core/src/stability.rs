@@ -27,14 +27,7 @@ impl StabilityEstimate {
     /// Estimates `ω_max` for `model` at the particles' current positions.
     pub fn of(model: &Model, particles: &Particles) -> Self {
         let n = particles.len();
-        let penalty_k: f64 = model
-            .colliders
-            .iter()
-            .map(|c| match c.response {
-                Response::Penalty { kc, .. } => kc,
-                _ => 0.0,
-            })
-            .sum();
+        let penalty_k = penalty_stiffness(model);
         if n == 0 || (model.springs.is_empty() && penalty_k == 0.0) {
             return Self { omega_max: 0.0 };
         }
@@ -64,10 +57,48 @@ impl StabilityEstimate {
         }
     }
 
-    /// The largest stable step of `integrator` in seconds, or `None` where the scheme has no
-    /// such limit for undamped oscillation (explicit Euler and midpoint amplify every
-    /// oscillation slightly and rely on damping; 2/ω is reported for them as a practical
-    /// bound).
+    /// An upper bound on `ω_max` that needs no geometry (for a state that has overflowed):
+    /// by Gershgorin's theorem no eigenvalue of `M⁻¹K` exceeds the largest row sum,
+    /// `(2 Σ ks + kc) / m` over the springs at a particle. Never below [`Self::of`].
+    ///
+    /// ```
+    /// use hooke_core::{Model, Particles, Spring, SpringKind, StabilityEstimate, Vec3};
+    /// let mut p = Particles::default();
+    /// p.push(Vec3::zeros(), Vec3::zeros(), 1.0);
+    /// p.push(Vec3::new(1.0, 0.0, 0.0), Vec3::zeros(), 1.0);
+    /// let model = Model {
+    ///     springs: vec![Spring { i: 0, j: 1, rest: 1.0, ks: 100.0, kd: 0.0, kind: SpringKind::Structural }],
+    ///     ..Model::default()
+    /// };
+    /// // Two unit masses on a spring of 100 N/m: ω = √(2 · 100); the bound is √(2 · 100) too.
+    /// let exact = StabilityEstimate::of(&model, &p).omega_max;
+    /// let bound = StabilityEstimate::bound(&model, &p).omega_max;
+    /// assert!((exact - 200f64.sqrt()).abs() < 1e-9);
+    /// assert!(bound >= exact);
+    /// ```
+    pub fn bound(model: &Model, particles: &Particles) -> Self {
+        let penalty_k = penalty_stiffness(model);
+        let mut row = vec![penalty_k; particles.len()];
+        for s in &model.springs {
+            row[s.i as usize] += 2.0 * s.ks;
+            row[s.j as usize] += 2.0 * s.ks;
+        }
+        let lambda = row
+            .iter()
+            .zip(&particles.mass)
+            .zip(&particles.inv_mass)
+            .filter(|(_, inv)| **inv != 0.0)
+            .map(|((k, m), _)| k / m)
+            .fold(0.0, f64::max);
+        Self {
+            omega_max: lambda.sqrt(),
+        }
+    }
+
+    /// The largest stable step of `integrator` in seconds; infinite where the scheme has no
+    /// such limit (backward Euler, or a system without springs). Explicit Euler and midpoint
+    /// amplify every undamped oscillation slightly at any step and rely on damping; for them
+    /// 2/ω is reported as the bound beyond which damping cannot help.
     pub fn max_dt(&self, integrator: Integrator) -> f64 {
         if self.omega_max == 0.0 {
             return f64::INFINITY;
@@ -81,6 +112,18 @@ impl StabilityEstimate {
         };
         bound / self.omega_max
     }
+}
+
+/// The penalty colliders' stiffness, summed: the most a particle touching all of them feels.
+fn penalty_stiffness(model: &Model) -> f64 {
+    model
+        .colliders
+        .iter()
+        .map(|c| match c.response {
+            Response::Penalty { kc, .. } => kc,
+            _ => 0.0,
+        })
+        .sum()
 }
 
 fn apply(model: &Model, p: &Particles, penalty_k: f64, u: &[Vec3], out: &mut [Vec3]) {

@@ -50,15 +50,16 @@ impl Camera {
     }
 
     /// World → clip space for an image of the given aspect ratio (width / height).
+    ///
+    /// A degenerate camera (distance zero or not finite) gives a matrix that draws nothing
+    /// sensible, but never a panic; callers check their input (the CLI refuses `--zoom 0`).
     pub fn view_projection(&self, aspect: f64) -> Matrix4<f64> {
         let eye = Point3::from(self.eye());
         let view = Matrix4::look_at_rh(&eye, &Point3::from(self.target), &Vector3::y());
-        let projection = Perspective3::new(
-            aspect,
-            self.fov_y.to_radians(),
-            self.near(),
-            self.distance * 20.0,
-        );
+        // nalgebra asserts that the planes differ.
+        let near = self.near().max(f64::MIN_POSITIVE);
+        let far = (self.distance * 20.0).max(2.0 * near);
+        let projection = Perspective3::new(aspect, self.fov_y.to_radians(), near, far);
         projection.as_matrix() * view
     }
 }
