@@ -1,6 +1,6 @@
 //! Reading triangle meshes from Wavefront OBJ text with `tobj`, and placing them in the world.
 
-use hooke_core::Vec3;
+use hooke_core::{SANE_BOUND, Vec3};
 use nalgebra::Rotation3;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
@@ -150,7 +150,7 @@ pub fn parse_obj(
             path: path.to_path_buf(),
             line: n + 1,
             reason,
-            text: line.trim().to_string(),
+            text: excerpt(line.trim()),
         };
         match words.next() {
             Some("v") => {
@@ -160,15 +160,23 @@ pub fn parse_obj(
                 }
                 for w in coordinates {
                     match w.parse::<f64>() {
-                        Ok(x) if x.is_finite() => {}
+                        Ok(x) if x.abs() <= SANE_BOUND => {}
+                        Ok(x) if x.is_finite() => {
+                            return Err(bad(format!(
+                                "vertex coordinate {} is beyond {} m, the extent of a \
+                                 simulated world",
+                                hooke_core::Num(x),
+                                hooke_core::Num(SANE_BOUND)
+                            )));
+                        }
                         Ok(_) => {
                             return Err(MeshError::NonFinite {
                                 path: path.to_path_buf(),
                                 line: n + 1,
-                                text: line.trim().to_string(),
+                                text: excerpt(line.trim()),
                             });
                         }
-                        Err(_) => return Err(bad(format!("'{w}' is not a number"))),
+                        Err(_) => return Err(bad(format!("'{}' is not a number", excerpt(w)))),
                     }
                 }
             }
@@ -190,7 +198,8 @@ pub fn parse_obj(
                     };
                     if !valid {
                         return Err(bad(format!(
-                            "face vertex '{c}' does not name one of the file's {vertices} vertices"
+                            "face vertex '{}' does not name one of the file's {vertices} vertices",
+                            excerpt(c)
                         )));
                     }
                 }
@@ -234,5 +243,33 @@ pub fn parse_obj(
             path: path.to_path_buf(),
         });
     }
+    let far = parts
+        .iter()
+        .flat_map(|p| &p.vertices)
+        .find(|v| v.amax().is_nan() || v.amax() > SANE_BOUND);
+    if let Some(v) = far {
+        return Err(MeshError::Obj {
+            path: path.to_path_buf(),
+            reason: format!(
+                "a placed vertex lies at ({}, {}, {}), beyond {} m of the origin; check the \
+                 collider's translate and scale",
+                hooke_core::Num(v.x),
+                hooke_core::Num(v.y),
+                hooke_core::Num(v.z),
+                hooke_core::Num(SANE_BOUND)
+            ),
+        });
+    }
     Ok(parts)
+}
+
+/// Characters of a line echoed in an error.
+const EXCERPT_CHARS: usize = 80;
+
+/// At most [`EXCERPT_CHARS`] characters of `text`, with `…` where it was cut.
+fn excerpt(text: &str) -> String {
+    match text.char_indices().nth(EXCERPT_CHARS) {
+        Some((cut, _)) => format!("{}…", &text[..cut]),
+        None => text.to_string(),
+    }
 }

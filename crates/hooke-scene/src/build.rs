@@ -7,6 +7,7 @@ use hooke_core::{
     Collider, ColliderSlot, DEFAULT_CLOTH_THICKNESS, DEFAULT_SURFACE_FRICTION, ForceField, Model,
     Particles, Response, Simulation, Spring, SpringKind, Surface, Vec3,
 };
+use hooke_core::{Num, SANE_BOUND};
 use nalgebra::Rotation3;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -246,8 +247,14 @@ impl SceneSpec {
                     Err(invalid(
                         "simulation.duration",
                         format!(
-                            "{} s at dt = {} s is {n:.3e} steps; expected 1 to {MAX_STEPS}",
-                            t.0, sim.dt.0
+                            "{} s at dt = {} s is {}; expected 1 to {MAX_STEPS} steps",
+                            Num(t.0),
+                            Num(sim.dt.0),
+                            if n < 1.0 {
+                                "less than one step".to_string()
+                            } else {
+                                format!("{n:.3e} steps")
+                            }
                         ),
                     ))
                 } else {
@@ -274,6 +281,16 @@ impl SceneSpec {
         let mut surfaces = Vec::new();
         for (b, body) in self.bodies.iter().enumerate() {
             let key = format!("body[{b}] '{}'", body.name);
+            // Exports and messages name bodies: two of one name could not be told apart.
+            if let Some(first) = self.bodies[..b].iter().position(|o| o.name == body.name) {
+                return Err(invalid(
+                    format!("{key}.name"),
+                    format!(
+                        "body[{first}] already has the name '{}'; names must differ",
+                        body.name
+                    ),
+                ));
+            }
             let start = particles.len();
             // Checked before anything is allocated.
             if particle_count(&body.shape)
@@ -320,6 +337,24 @@ impl SceneSpec {
                     .velocities
                     .as_ref()
                     .map_or(vec3(&body.velocity), |vs| vec3(&vs[p]));
+                if x.amax().is_nan() || x.amax() > SANE_BOUND {
+                    let what = if body.positions.is_some() {
+                        "positions"
+                    } else {
+                        "origin"
+                    };
+                    return Err(invalid(
+                        format!("{key}.{what}"),
+                        format!(
+                            "particle {p} would start at ({}, {}, {}), beyond {} m of the origin \
+                             (the extent of a simulated world)",
+                            Num(x.x),
+                            Num(x.y),
+                            Num(x.z),
+                            Num(SANE_BOUND)
+                        ),
+                    ));
+                }
                 particles.push(x, v, body.mass.0);
             }
             for (k, &pin) in body.pins.iter().enumerate() {
@@ -519,17 +554,18 @@ fn build_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, Bu
         .size
         .iter()
         .try_fold(1usize, |acc, &n| acc.checked_mul(n));
-    match count {
-        Some(n) if (1..=MAX_PARTICLES).contains(&n) => {}
-        _ => {
-            return Err(invalid(
-                format!("{key}.shape.size"),
-                format!(
-                    "expected 1 to {MAX_PARTICLES} particles, found size {:?}",
-                    lattice.size
-                ),
-            ));
-        }
+    if !count.is_some_and(|n| (1..=MAX_PARTICLES).contains(&n)) {
+        let total = count.map_or("more than 2^64".to_string(), |n| n.to_string());
+        let (field, found) = match &body.shape {
+            ShapeSpec::Chain { count, .. } => ("count", format!("{count}")),
+            ShapeSpec::Grid { size, .. } => ("size", format!("{size:?} ({total} particles)")),
+            ShapeSpec::Lattice { size, .. } => ("size", format!("{size:?} ({total} particles)")),
+            ShapeSpec::Points { positions } => ("positions", format!("{} points", positions.len())),
+        };
+        return Err(invalid(
+            format!("{key}.shape.{field}"),
+            format!("expected 1 to {MAX_PARTICLES} particles, found {found}"),
+        ));
     }
     let local = lattice.positions(h);
     let mut springs = Vec::new();
@@ -587,6 +623,17 @@ fn pairs(
             })
         })
         .collect()
+}
+
+/// The size in bytes of the mesh a path names (0 when it cannot be found: the build says why).
+pub(crate) fn mesh_file_len(path: &str, base: &Path) -> u64 {
+    match path.strip_prefix("builtin:") {
+        Some(name) => BUILTIN_MESHES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map_or(0, |(_, text)| text.len() as u64),
+        None => std::fs::metadata(base.join(path)).map_or(0, |m| m.len()),
+    }
 }
 
 /// Where a mesh path points: a built-in mesh or a file.

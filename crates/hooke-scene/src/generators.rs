@@ -74,14 +74,8 @@ impl Lattice {
     /// The springs of one family. Rest lengths are `h √(di² + dj² + dk²)` from the integer
     /// offsets, the undeformed lattice's distances (`h`, `√2 h`, `√3 h`, `2 h`).
     pub fn edges(&self, kind: SpringKind, h: f64) -> Vec<Edge> {
-        let pairs: Vec<([usize; 3], [usize; 3])> = match kind {
-            SpringKind::Structural => (0..3).map(|axis| ([0; 3], unit(axis, 1))).collect(),
-            SpringKind::Shear => SHEAR.to_vec(),
-            SpringKind::Bend => (0..3).map(|axis| ([0; 3], unit(axis, 2))).collect(),
-            SpringKind::Other => Vec::new(),
-        };
-        let mut out = Vec::new();
-        for (a, b) in pairs {
+        let mut out = Vec::with_capacity(self.edge_count(kind));
+        for (a, b) in offsets(kind) {
             let span = [0, 1, 2].map(|d| a[d].max(b[d]));
             if (0..3).any(|d| span[d] >= self.size[d]) {
                 continue;
@@ -107,6 +101,38 @@ impl Lattice {
     }
 }
 
+impl Lattice {
+    /// How many springs [`Lattice::edges`] gives for `kind`, without making them (saturating
+    /// at `usize::MAX` for sizes no machine could build).
+    ///
+    /// ```
+    /// use hooke_scene::generators::Lattice;
+    /// use hooke_core::SpringKind;
+    /// let cube = Lattice { size: [8, 8, 8] };
+    /// assert_eq!(cube.edge_count(SpringKind::Shear), cube.edges(SpringKind::Shear, 1.0).len());
+    /// ```
+    pub fn edge_count(&self, kind: SpringKind) -> usize {
+        offsets(kind)
+            .iter()
+            .map(|(a, b)| {
+                (0..3)
+                    .map(|d| self.size[d].saturating_sub(a[d].max(b[d])))
+                    .fold(1usize, usize::saturating_mul)
+            })
+            .fold(0usize, usize::saturating_add)
+    }
+}
+
+/// The corner offsets joined by the springs of one family.
+fn offsets(kind: SpringKind) -> Vec<([usize; 3], [usize; 3])> {
+    match kind {
+        SpringKind::Structural => (0..3).map(|axis| ([0; 3], unit(axis, 1))).collect(),
+        SpringKind::Shear => SHEAR.to_vec(),
+        SpringKind::Bend => (0..3).map(|axis| ([0; 3], unit(axis, 2))).collect(),
+        SpringKind::Other => Vec::new(),
+    }
+}
+
 fn unit(axis: usize, length: usize) -> [usize; 3] {
     let mut v = [0; 3];
     v[axis] = length;
@@ -118,7 +144,10 @@ mod tests {
     use super::*;
 
     fn count(size: [usize; 3], kind: SpringKind) -> usize {
-        Lattice { size }.edges(kind, 1.0).len()
+        let lattice = Lattice { size };
+        let n = lattice.edges(kind, 1.0).len();
+        assert_eq!(lattice.edge_count(kind), n, "{size:?} {kind:?}");
+        n
     }
 
     #[test]

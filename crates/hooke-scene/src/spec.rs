@@ -19,7 +19,10 @@ impl TryFrom<f64> for Finite {
         if x.is_finite() {
             Ok(Self(x))
         } else {
-            Err(format!("expected a finite number, found {x}"))
+            Err(format!(
+                "expected a finite number, found {}",
+                hooke_core::Num(x)
+            ))
         }
     }
 }
@@ -41,7 +44,10 @@ impl TryFrom<f64> for Positive {
         if x.is_finite() && x > 0.0 {
             Ok(Self(x))
         } else {
-            Err(format!("expected a finite number > 0, found {x}"))
+            Err(format!(
+                "expected a finite number > 0, found {}",
+                hooke_core::Num(x)
+            ))
         }
     }
 }
@@ -63,7 +69,10 @@ impl TryFrom<f64> for NonNegative {
         if x.is_finite() && x >= 0.0 {
             Ok(Self(x))
         } else {
-            Err(format!("expected a finite number >= 0, found {x}"))
+            Err(format!(
+                "expected a finite number >= 0, found {}",
+                hooke_core::Num(x)
+            ))
         }
     }
 }
@@ -85,7 +94,10 @@ impl TryFrom<f64> for Fraction {
         if (0.0..=1.0).contains(&x) {
             Ok(Self(x))
         } else {
-            Err(format!("expected a number in [0, 1], found {x}"))
+            Err(format!(
+                "expected a number in [0, 1], found {}",
+                hooke_core::Num(x)
+            ))
         }
     }
 }

@@ -14,10 +14,12 @@
 //!
 //! The course reads these files with `fscanf`, so line breaks are just white space: the reader
 //! here takes whitespace-separated tokens too, and reports each problem with the line of the
-//! token where it went wrong and what was expected there. The writer prints numbers in Rust's
-//! shortest round-trip form (the course writes `%lf`, six decimals), so write → read is exact.
+//! token where it went wrong and what was expected there. The writer prints numbers in their
+//! shortest round-trip form ([`hooke_core::Num`]; the course writes `%lf`, six decimals, and
+//! its `fscanf` reads scientific form too), so write → read is exact.
 
 use crate::spec::*;
+use hooke_core::Num;
 use hooke_core::{Integrator, Vec3};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -87,24 +89,38 @@ pub enum WorldError {
     },
 }
 
+/// The words of a world, with their lines, read one at a time: a world with a large force
+/// field is never held as a list of its words (which would take several times its size).
 struct Tokens<'a> {
     path: &'a Path,
-    words: Vec<(usize, &'a str)>,
-    next: usize,
+    words: std::iter::Peekable<Box<dyn Iterator<Item = (usize, &'a str)> + 'a>>,
+    /// The line of the word read last.
+    line: usize,
     last_line: usize,
+}
+
+/// Characters of a word echoed in an error.
+const EXCERPT_CHARS: usize = 40;
+
+/// At most [`EXCERPT_CHARS`] characters of `word`, with `…` where it was cut.
+fn excerpt(word: &str) -> String {
+    match word.char_indices().nth(EXCERPT_CHARS) {
+        Some((cut, _)) => format!("{}…", &word[..cut]),
+        None => word.to_string(),
+    }
 }
 
 impl<'a> Tokens<'a> {
     fn new(text: &'a str, path: &'a Path) -> Self {
-        let words: Vec<(usize, &str)> = text
-            .lines()
-            .enumerate()
-            .flat_map(|(n, line)| line.split_whitespace().map(move |w| (n + 1, w)))
-            .collect();
+        let words: Box<dyn Iterator<Item = (usize, &'a str)> + 'a> = Box::new(
+            text.lines()
+                .enumerate()
+                .flat_map(|(n, line)| line.split_whitespace().map(move |w| (n + 1, w))),
+        );
         Self {
             path,
-            words,
-            next: 0,
+            words: words.peekable(),
+            line: 1,
             last_line: text.lines().count().max(1),
         }
     }
@@ -118,9 +134,9 @@ impl<'a> Tokens<'a> {
     }
 
     fn word(&mut self, what: &str) -> Result<(usize, &'a str), WorldError> {
-        match self.words.get(self.next) {
-            Some(&w) => {
-                self.next += 1;
+        match self.words.next() {
+            Some(w) => {
+                self.line = w.0;
                 Ok(w)
             }
             None => Err(self.fail(
@@ -136,9 +152,12 @@ impl<'a> Tokens<'a> {
             Ok(x) if x.is_finite() => Ok(x),
             Ok(_) => Err(self.fail(
                 line,
-                format!("expected {what} as a finite number, found '{w}'"),
+                format!("expected {what} as a finite number, found '{}'", excerpt(w)),
             )),
-            Err(_) => Err(self.fail(line, format!("expected {what} (a number), found '{w}'"))),
+            Err(_) => Err(self.fail(
+                line,
+                format!("expected {what} (a number), found '{}'", excerpt(w)),
+            )),
         }
     }
 
@@ -148,12 +167,12 @@ impl<'a> Tokens<'a> {
         ok: impl Fn(f64) -> bool,
         rule: &str,
     ) -> Result<f64, WorldError> {
-        let line = self.words.get(self.next).map_or(self.last_line, |w| w.0);
+        let line = self.words.peek().map_or(self.last_line, |w| w.0);
         let x = self.number(what)?;
         if ok(x) {
             Ok(x)
         } else {
-            Err(self.fail(line, format!("expected {what} {rule}, found {x}")))
+            Err(self.fail(line, format!("expected {what} {rule}, found {}", Num(x))))
         }
     }
 
@@ -164,7 +183,7 @@ impl<'a> Tokens<'a> {
             Ok(n) => Err(self.fail(line, format!("expected {what} from 0 to {max}, found {n}"))),
             Err(_) => Err(self.fail(
                 line,
-                format!("expected {what} (a whole number), found '{w}'"),
+                format!("expected {what} (a whole number), found '{}'", excerpt(w)),
             )),
         }
     }
@@ -209,10 +228,7 @@ pub fn parse_world(text: &str, path: &Path) -> Result<World, WorldError> {
     let dt = t.checked("the step size dt", |x| x > 0.0, "> 0")?;
     let every = t.integer("the frame cadence n", u32::MAX as u64)?;
     if every == 0 {
-        return Err(t.fail(
-            t.words[t.next - 1].0,
-            "expected the frame cadence n >= 1, found 0".into(),
-        ));
+        return Err(t.fail(t.line, "expected the frame cadence n >= 1, found 0".into()));
     }
     let non_negative = |x: f64| x >= 0.0;
     let k_elastic = t.checked("kElastic", non_negative, ">= 0")?;
@@ -229,10 +245,7 @@ pub fn parse_world(text: &str, path: &Path) -> Result<World, WorldError> {
                 t.number("plane d")?,
             ];
             if c[..3].iter().all(|x| *x == 0.0) {
-                return Err(t.fail(
-                    t.words[t.next - 1].0,
-                    "expected a plane: a, b and c are all zero".into(),
-                ));
+                return Err(t.fail(t.line, "expected a plane: a, b and c are all zero".into()));
             }
             Some(c)
         }
@@ -242,10 +255,13 @@ pub fn parse_world(text: &str, path: &Path) -> Result<World, WorldError> {
     let field = t.vectors(resolution.pow(3), "force-field vector")?;
     let positions = t.vectors(POINTS, "position")?;
     let velocities = t.vectors(POINTS, "velocity")?;
-    if let Some(&(line, w)) = t.words.get(t.next) {
+    if let Some(&(line, w)) = t.words.peek() {
         return Err(t.fail(
             line,
-            format!("expected the end of the file after 512 velocities, found '{w}'"),
+            format!(
+                "expected the end of the file after 512 velocities, found '{}'",
+                excerpt(w)
+            ),
         ));
     }
     Ok(World {
@@ -284,16 +300,19 @@ impl World {
             "Euler"
         };
         let _ = writeln!(s, "{name}");
-        let _ = writeln!(s, "{} {}", self.dt, self.every);
+        let _ = writeln!(s, "{} {}", Num(self.dt), self.every);
         let _ = writeln!(
             s,
             "{} {} {} {}",
-            self.k_elastic, self.d_elastic, self.k_collision, self.d_collision
+            Num(self.k_elastic),
+            Num(self.d_elastic),
+            Num(self.k_collision),
+            Num(self.d_collision)
         );
-        let _ = writeln!(s, "{}", self.mass);
+        let _ = writeln!(s, "{}", Num(self.mass));
         match self.plane {
             Some([a, b, c, d]) => {
-                let _ = writeln!(s, "1\n{a} {b} {c} {d}");
+                let _ = writeln!(s, "1\n{} {} {} {}", Num(a), Num(b), Num(c), Num(d));
             }
             None => s.push_str("0\n"),
         }
@@ -304,7 +323,7 @@ impl World {
             .chain(&self.positions)
             .chain(&self.velocities)
         {
-            let _ = writeln!(s, "{} {} {}", v.x, v.y, v.z);
+            let _ = writeln!(s, "{} {} {}", Num(v.x), Num(v.y), Num(v.z));
         }
         s
     }

@@ -1,0 +1,209 @@
+//! How much memory a scene will need, estimated from its description before anything is
+//! built, so that a scene too large for the machine is refused in milliseconds with the key
+//! to change, not after minutes of swapping.
+//!
+//! The costs per item are measured peaks of `hooke run SCENE --steps 1` (the build, the
+//! stability estimate and one step, integrator workspaces included) on large lattices and
+//! grids, rounded up: they over-estimate by about a fifth on those scenes, which is the
+//! side to err on.
+
+use crate::generators::Lattice;
+use crate::spec::{ColliderShapeSpec, SceneSpec, ShapeSpec};
+use hooke_core::SpringKind;
+use std::path::Path;
+
+/// Bytes per particle: state, masses, integrator stages, assembly and per-particle indices.
+pub const BYTES_PER_PARTICLE: u64 = 450;
+/// Bytes per spring: the spring, its copy in the assembly's layout and build temporaries.
+pub const BYTES_PER_SPRING: u64 = 80;
+/// Extra bytes per particle of a surface with a contact thickness: triangles, the hashed
+/// grid and candidate lists.
+pub const BYTES_PER_SURFACE_PARTICLE: u64 = 500;
+/// Bytes per force-field node: the parsed values, the scene's copy and the built field.
+pub const BYTES_PER_FIELD_NODE: u64 = 80;
+/// Bytes per byte of an OBJ table file: tobj's buffers, the triangle mesh, its BVH and the
+/// drawn copy.
+pub const BYTES_PER_MESH_FILE_BYTE: u64 = 12;
+
+/// A scene's estimated size and memory.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Footprint {
+    /// Particles in all bodies.
+    pub particles: u64,
+    /// Springs, generated and explicit.
+    pub springs: u64,
+    /// Particles of bodies whose surface has a contact thickness.
+    pub surface_particles: u64,
+    /// Force-field nodes.
+    pub field_nodes: u64,
+    /// Bytes of OBJ files the colliders load.
+    pub mesh_file_bytes: u64,
+    /// The scene key that costs the most, and its bytes: what to change when the whole is
+    /// too large (for example `body[0] 'cube'.shape.size`).
+    pub largest: Option<(String, u64)>,
+}
+
+impl Footprint {
+    /// The estimated peak memory in bytes.
+    pub fn bytes(&self) -> u64 {
+        self.particles
+            .saturating_mul(BYTES_PER_PARTICLE)
+            .saturating_add(self.springs.saturating_mul(BYTES_PER_SPRING))
+            .saturating_add(
+                self.surface_particles
+                    .saturating_mul(BYTES_PER_SURFACE_PARTICLE),
+            )
+            .saturating_add(self.field_nodes.saturating_mul(BYTES_PER_FIELD_NODE))
+            .saturating_add(
+                self.mesh_file_bytes
+                    .saturating_mul(BYTES_PER_MESH_FILE_BYTE),
+            )
+    }
+
+    fn note(&mut self, key: String, bytes: u64) {
+        if self.largest.as_ref().is_none_or(|(_, b)| bytes > *b) {
+            self.largest = Some((key, bytes));
+        }
+    }
+}
+
+impl SceneSpec {
+    /// Estimates the memory building and running this scene takes, without building it.
+    /// Mesh files are looked up relative to `base` (as [`SceneSpec::build`] does); a file
+    /// that cannot be found counts as empty (the build reports it).
+    ///
+    /// ```
+    /// let spec = hooke_scene::builtin::builtin("hanging-cloth").unwrap();
+    /// let f = spec.footprint(std::path::Path::new("."));
+    /// assert_eq!(f.particles, 625);
+    /// assert!(f.bytes() > 500_000 && f.bytes() < 2_000_000);
+    /// ```
+    pub fn footprint(&self, base: &Path) -> Footprint {
+        let mut f = Footprint::default();
+        for (b, body) in self.bodies.iter().enumerate() {
+            let key = format!("body[{b}] '{}'", body.name);
+            let (lattice, size_key) = match &body.shape {
+                ShapeSpec::Chain { count, .. } => (
+                    Lattice {
+                        size: [*count, 1, 1],
+                    },
+                    "count",
+                ),
+                ShapeSpec::Grid { size, .. } => (
+                    Lattice {
+                        size: [size[0], 1, size[1]],
+                    },
+                    "size",
+                ),
+                ShapeSpec::Lattice { size, .. } => (Lattice { size: *size }, "size"),
+                ShapeSpec::Points { positions } => (
+                    Lattice {
+                        size: [positions.len(), 1, 1],
+                    },
+                    "positions",
+                ),
+            };
+            let particles = lattice
+                .size
+                .iter()
+                .fold(1u64, |a, &n| a.saturating_mul(n as u64));
+            let generated = !matches!(body.shape, ShapeSpec::Points { .. });
+            let mut springs = body.springs.pairs.len() as u64;
+            if generated {
+                for kind in [SpringKind::Structural, SpringKind::Shear, SpringKind::Bend] {
+                    if body.springs.params(kind).is_some() {
+                        springs = springs.saturating_add(lattice.edge_count(kind) as u64);
+                    }
+                }
+            }
+            // A grid has a surface with a thickness unless it is set to zero.
+            let surface = matches!(body.shape, ShapeSpec::Grid { .. })
+                && body.thickness.is_none_or(|t| t.0 > 0.0);
+            let surface_particles = if surface { particles } else { 0 };
+            f.particles = f.particles.saturating_add(particles);
+            f.springs = f.springs.saturating_add(springs);
+            f.surface_particles = f.surface_particles.saturating_add(surface_particles);
+            let bytes = Footprint {
+                particles,
+                springs,
+                surface_particles,
+                ..Footprint::default()
+            }
+            .bytes();
+            let key = if body.springs.pairs.len() as u64 * 2 > springs {
+                format!("{key}.springs.pairs")
+            } else {
+                format!("{key}.shape.{size_key}")
+            };
+            f.note(key, bytes);
+        }
+        if let Some(field) = &self.force_field {
+            let r = field.resolution as u64;
+            f.field_nodes = r.saturating_mul(r).saturating_mul(r);
+            f.note(
+                "force_field.resolution".into(),
+                f.field_nodes.saturating_mul(BYTES_PER_FIELD_NODE),
+            );
+        }
+        for (c, collider) in self.colliders.iter().enumerate() {
+            if let ColliderShapeSpec::Mesh { path, .. } = &collider.shape {
+                let bytes = crate::build::mesh_file_len(path, base);
+                f.mesh_file_bytes = f.mesh_file_bytes.saturating_add(bytes);
+                f.note(
+                    format!("collider[{c}].shape.path"),
+                    bytes.saturating_mul(BYTES_PER_MESH_FILE_BYTE),
+                );
+            }
+        }
+        f
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::builtin::BUILTINS;
+
+    /// The estimate counts exactly what the build makes, for every built-in and for a
+    /// lattice, a grid and a chain of odd sizes.
+    #[test]
+    fn counts_match_the_built_scenes() {
+        let mut specs: Vec<SceneSpec> = BUILTINS.iter().map(|(_, make)| make()).collect();
+        for size in [[3, 5, 7], [1, 9, 2], [2, 2, 2]] {
+            let mut spec = crate::builtin::builtin("jello-cube").unwrap();
+            if let ShapeSpec::Lattice { size: s, .. } = &mut spec.bodies[0].shape {
+                *s = size;
+            }
+            specs.push(spec);
+        }
+        specs.push(crate::workload::cloth(17));
+        for spec in specs {
+            let f = spec.footprint(Path::new("."));
+            let scene = spec.build(Path::new(".")).unwrap();
+            let sim = &scene.simulation;
+            assert_eq!(f.particles as usize, sim.particles().len(), "{}", spec.name);
+            assert_eq!(
+                f.springs as usize,
+                sim.model().springs.len(),
+                "{}",
+                spec.name
+            );
+            let surfaces: usize = sim.model().surfaces.iter().map(|s| s.particles.len()).sum();
+            assert_eq!(f.surface_particles as usize, surfaces, "{}", spec.name);
+            assert!(f.largest.is_some());
+        }
+    }
+
+    /// A lattice too large for any machine is estimated without overflow, and the key to
+    /// change is its size.
+    #[test]
+    fn huge_scenes_saturate_and_name_their_key() {
+        let mut spec = crate::builtin::builtin("jello-cube").unwrap();
+        if let ShapeSpec::Lattice { size, .. } = &mut spec.bodies[0].shape {
+            *size = [usize::MAX / 2, 3, 3];
+        }
+        let f = spec.footprint(Path::new("."));
+        assert_eq!(f.bytes(), u64::MAX);
+        assert_eq!(f.largest.unwrap().0, "body[0] 'jelly'.shape.size");
+    }
+}
