@@ -1,14 +1,14 @@
-//! Rendering scenes to PNG stills and GIF animations, written atomically.
+//! Rendering scenes to PNG stills and GIF animations, written atomically; a GIF is encoded
+//! frame by frame as a run produces them, so its memory does not grow with its length.
 
 use crate::draw::{Style, draw, frame_camera};
-use crate::output::write_atomic;
+use crate::output::{AtomicFile, write_atomic};
 use anyhow::{Context, Result};
 use hooke_render::{Camera, RenderOptions, render};
 use hooke_scene::Scene;
-use image::codecs::gif::{GifEncoder, Repeat};
-use image::{Delay, Frame, ImageFormat, RgbaImage};
+use image::{ImageFormat, RgbaImage};
 use std::io::Cursor;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Camera placement options shared by the commands that draw.
 #[derive(clap::Args, Clone, Debug)]
@@ -20,16 +20,16 @@ pub struct View {
     #[arg(long, value_enum, default_value_t = Style::Solid)]
     pub style: Style,
     /// Camera rotation about the vertical, degrees.
-    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true, value_parser = parse_angle)]
     pub yaw: f64,
-    /// Camera elevation, degrees.
-    #[arg(long, default_value_t = 22.0, allow_negative_numbers = true)]
+    /// Camera elevation, degrees, from -89 to 89.
+    #[arg(long, default_value_t = 22.0, allow_negative_numbers = true, value_parser = parse_pitch)]
     pub pitch: f64,
-    /// Multiply the framing distance (less than 1 zooms in).
-    #[arg(long, default_value_t = 1.0)]
+    /// Multiply the framing distance, from 0.001 to 1000 (less than 1 zooms in).
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = parse_zoom)]
     pub zoom: f64,
-    /// Samples per pixel along each axis (2 = 4× anti-aliasing, 1 = off).
-    #[arg(long, default_value_t = 2)]
+    /// Samples per pixel along each axis, 1 to 4 (2 = 4× anti-aliasing, 1 = off).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=4))]
     pub supersample: u32,
 }
 
@@ -47,6 +47,36 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     }
 }
 
+/// Parses a number within `[lo, hi]` for a command-line option.
+pub fn parse_within(s: &str, lo: f64, hi: f64, what: &str) -> Result<f64, String> {
+    let x: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("expected {what}, found '{s}'"))?;
+    if x.is_finite() && (lo..=hi).contains(&x) {
+        Ok(x)
+    } else {
+        Err(format!(
+            "expected {what} from {} to {}, found {s}",
+            hooke_core::Num(lo),
+            hooke_core::Num(hi)
+        ))
+    }
+}
+
+fn parse_angle(s: &str) -> Result<f64, String> {
+    parse_within(s, -3600.0, 3600.0, "an angle in degrees")
+}
+
+fn parse_pitch(s: &str) -> Result<f64, String> {
+    // At ±90° the view direction is the up vector and the camera has no orientation.
+    parse_within(s, -89.0, 89.0, "an elevation in degrees")
+}
+
+fn parse_zoom(s: &str) -> Result<f64, String> {
+    parse_within(s, 1e-3, 1e3, "a zoom factor")
+}
+
 impl View {
     /// The camera for the scene's current state.
     pub fn camera(&self, scene: &Scene) -> Camera {
@@ -60,7 +90,7 @@ impl View {
         let options = RenderOptions {
             width: self.size.0,
             height: self.size.1,
-            supersample: self.supersample.clamp(1, 4),
+            supersample: self.supersample,
             ..RenderOptions::default()
         };
         let pixels = render(&draw(scene, self.style), camera, &options);
@@ -78,19 +108,68 @@ pub fn write_png(path: &Path, image: &RgbaImage) -> Result<()> {
     write_atomic(path, &bytes)
 }
 
-/// Encodes frames as a looping GIF and writes it atomically.
-pub fn write_gif(path: &Path, frames: Vec<RgbaImage>, frame_ms: u32) -> Result<()> {
-    let mut bytes = Vec::new();
-    {
-        let mut encoder = GifEncoder::new_with_speed(&mut bytes, 10);
-        encoder.set_repeat(Repeat::Infinite).context("gif")?;
+/// A looping GIF animation written frame by frame; it appears at its path only on
+/// [`GifWriter::finish`], and a writer dropped unfinished leaves nothing behind.
+pub struct GifWriter {
+    path: PathBuf,
+    encoder: gif::Encoder<AtomicFile>,
+    size: (u16, u16),
+    /// Frame delay, hundredths of a second (GIF's unit).
+    delay: u16,
+    frames: u64,
+}
+
+impl GifWriter {
+    /// Starts a GIF of `size` pixels showing each frame for `frame_ms` milliseconds
+    /// (rounded to GIF's 10 ms, at least 20 ms: viewers slow faster frames down).
+    pub fn create(path: &Path, size: (u32, u32), frame_ms: u32) -> Result<Self> {
+        let cannot = || format!("cannot write {}", path.display());
+        let w = u16::try_from(size.0).with_context(cannot)?;
+        let h = u16::try_from(size.1).with_context(cannot)?;
+        let file = AtomicFile::create(path)?;
+        let mut encoder = gif::Encoder::new(file, w, h, &[]).with_context(cannot)?;
         encoder
-            .encode_frames(
-                frames
-                    .into_iter()
-                    .map(|f| Frame::from_parts(f, 0, 0, Delay::from_numer_denom_ms(frame_ms, 1))),
-            )
-            .with_context(|| format!("cannot encode {}", path.display()))?;
+            .set_repeat(gif::Repeat::Infinite)
+            .with_context(cannot)?;
+        let delay = (frame_ms.div_ceil(10)).clamp(2, u16::MAX as u32) as u16;
+        Ok(Self {
+            path: path.to_path_buf(),
+            encoder,
+            size: (w, h),
+            delay,
+            frames: 0,
+        })
     }
-    write_atomic(path, &bytes)
+
+    /// Quantises and appends one frame of the GIF's size.
+    pub fn frame(&mut self, mut image: RgbaImage) -> Result<()> {
+        anyhow::ensure!(
+            image.dimensions() == (self.size.0 as u32, self.size.1 as u32),
+            "GIF frame of {:?} pixels in a GIF of {:?}",
+            image.dimensions(),
+            self.size
+        );
+        // Speed 10 as image's encoder uses: NeuQuant on a sample of the pixels.
+        let mut frame = gif::Frame::from_rgba_speed(self.size.0, self.size.1, &mut image, 10);
+        frame.delay = self.delay;
+        self.encoder
+            .write_frame(&frame)
+            .with_context(|| format!("cannot write {}", self.path.display()))?;
+        self.frames += 1;
+        Ok(())
+    }
+
+    /// Frames written so far.
+    pub fn frames(&self) -> u64 {
+        self.frames
+    }
+
+    /// Ends the GIF and puts it in place.
+    pub fn finish(self) -> Result<()> {
+        let file = self
+            .encoder
+            .into_inner()
+            .with_context(|| format!("cannot write {}", self.path.display()))?;
+        file.commit()
+    }
 }

@@ -1,16 +1,24 @@
-//! Ctrl-C (SIGINT) during a run: the run stops between steps, finishes the files it was
-//! writing at the last complete frame, and exits with status 130 (128 + SIGINT).
+//! Ctrl-C (SIGINT), SIGTERM and SIGHUP during a run: the run stops between steps, finishes
+//! the files it was writing at the last complete frame, and exits with status 130
+//! (128 + SIGINT).
+//!
+//! A second interrupt changes nothing (tools such as `timeout` and impatient users send
+//! two; the run is already stopping and its files must not be lost). A third forces the
+//! exit at once and removes the unfinished temporary files, for a run that does not respond.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicU32, Ordering};
 
-static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+static INTERRUPTS: AtomicU32 = AtomicU32::new(0);
 
 /// The exit status of an interrupted run.
 pub const EXIT_INTERRUPTED: u8 = 130;
 
+/// Interrupts after which the process exits at once.
+const FORCE_AFTER: u32 = 3;
+
 /// The run was interrupted: carried as an error so that every caller stops the same way.
 #[derive(Debug, thiserror::Error)]
-#[error("interrupted at step {step} (t = {time} s)")]
+#[error("interrupted at step {step} (t = {} s)", hooke_core::Num(*.time))]
 pub struct Interrupted {
     /// Steps completed.
     pub step: u64,
@@ -18,11 +26,17 @@ pub struct Interrupted {
     pub time: f64,
 }
 
-/// Installs the handler: the first Ctrl-C asks the run to stop; a second one, for a run that
-/// does not respond, exits at once.
+/// Installs the handler (see the module's documentation).
 pub fn install() {
     let result = ctrlc::set_handler(|| {
-        if INTERRUPTED.swap(true, Ordering::SeqCst) {
+        let count = INTERRUPTS.fetch_add(1, Ordering::SeqCst) + 1;
+        if count == 2 {
+            eprintln!(
+                "stopping at the last complete frame; interrupt once more to abandon the files"
+            );
+        } else if count >= FORCE_AFTER {
+            crate::output::remove_pending();
+            eprintln!("abandoned: unfinished files removed");
             std::process::exit(EXIT_INTERRUPTED as i32);
         }
     });
@@ -33,7 +47,12 @@ pub fn install() {
     }
 }
 
-/// Whether Ctrl-C was pressed.
+/// Whether an interrupt arrived.
 pub fn requested() -> bool {
-    INTERRUPTED.load(Ordering::Relaxed)
+    INTERRUPTS.load(Ordering::Relaxed) > 0
+}
+
+/// Whether `e` (or its cause) is an interrupt.
+pub fn is_interrupt(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| c.downcast_ref::<Interrupted>().is_some())
 }

@@ -5,8 +5,10 @@
 #![forbid(unsafe_code)]
 
 pub mod draw;
+pub mod driver;
 pub mod image_out;
 pub mod interrupt;
+pub mod memory;
 pub mod obj_export;
 pub mod output;
 pub mod source;

@@ -74,32 +74,63 @@ struct SetupArgs {
     #[arg(long)]
     integrator: Option<Integrator>,
     /// Step size in seconds.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_seconds)]
     dt: Option<f64>,
     /// Run this many steps.
-    #[arg(long, conflicts_with = "duration")]
+    #[arg(long, conflicts_with = "duration",
+          value_parser = clap::value_parser!(u64).range(1..=hooke_scene::MAX_STEPS))]
     steps: Option<u64>,
     /// Run this many seconds of simulated time.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_seconds)]
     duration: Option<f64>,
-    /// A frame every K steps.
-    #[arg(long, value_name = "K")]
-    every: Option<u64>,
-    /// Replace the scene's table with this OBJ file, or `cylinder` for the analytic one.
+    /// Replace the scene's table with this OBJ file (relative to the current folder), or
+    /// `cylinder` for the analytic one.
     #[arg(long, value_name = "OBJ|cylinder")]
     table: Option<String>,
 }
 
+/// A frame cadence: a whole number of steps, at least 1.
+fn parse_every(s: &str) -> Result<u64, String> {
+    match s.trim().parse::<u64>() {
+        Ok(k) if k >= 1 => Ok(k),
+        _ => Err(format!(
+            "expected a whole number of steps >= 1, found '{s}'"
+        )),
+    }
+}
+
+/// A time in seconds: finite and positive.
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        _ => Err(format!("expected a time in seconds > 0, found '{s}'")),
+    }
+}
+
 impl SetupArgs {
-    fn overrides(&self) -> Overrides {
-        Overrides {
+    /// The overrides; a table file is resolved against the current folder, as any path on
+    /// the command line is (not against the scene file's folder).
+    fn overrides(&self) -> anyhow::Result<Overrides> {
+        let table = match &self.table {
+            Some(t) if t == "cylinder" || t.starts_with("builtin:") => Some(t.clone()),
+            Some(t) => {
+                let path = std::path::Path::new(t);
+                if !path.is_file() {
+                    anyhow::bail!("--table {t}: no such file (expected an OBJ mesh or `cylinder`)");
+                }
+                let full = std::env::current_dir()?.join(path);
+                Some(full.to_string_lossy().into_owned())
+            }
+            None => None,
+        };
+        Ok(Overrides {
             integrator: self.integrator,
             dt: self.dt,
             steps: self.steps,
             duration: self.duration,
-            every: self.every,
-            table: self.table.clone(),
-        }
+            every: None,
+            table,
+        })
     }
 }
 
@@ -109,6 +140,9 @@ struct RunArgs {
     scene: String,
     #[command(flatten)]
     setup: SetupArgs,
+    /// A frame every K steps.
+    #[arg(long, value_name = "K", value_parser = parse_every)]
+    every: Option<u64>,
     /// Write the trajectory here (CSV as in docs/physics.md §6).
     #[arg(long, value_name = "FILE.csv")]
     trajectory: Option<PathBuf>,
@@ -136,7 +170,7 @@ struct RenderArgs {
     /// Simulated time of the still, seconds (default: the end of the scene's run).
     #[arg(long, allow_negative_numbers = true)]
     at: Option<f64>,
-    /// Output PNG.
+    /// Output PNG (the file name must end in .png).
     #[arg(short, long, value_name = "FILE.png")]
     output: PathBuf,
     #[command(flatten)]
@@ -162,6 +196,10 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(code) => code,
+        Err(e) if hooke_cli::interrupt::is_interrupt(&e) => {
+            eprintln!("{e:#}: stopped");
+            ExitCode::from(hooke_cli::interrupt::EXIT_INTERRUPTED)
+        }
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE

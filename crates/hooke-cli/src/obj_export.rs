@@ -7,11 +7,11 @@
 //! as `l` elements. Each collider is an object `collider:<index>-<kind>` of triangles: the
 //! analytic cylinder tessellated inside the true solid, the ground a square around the
 //! bodies' start, an inclined plane clipped to the scene's region. Numbers are Rust's
-//! shortest round-trip decimals; every file is written whole or not at all.
+//! shortest round-trip numbers ([`hooke_core::Num`]); every file is written whole or not at all.
 
 use crate::output::AtomicFile;
-use anyhow::{Context, Result, bail};
-use hooke_core::Vec3;
+use anyhow::{Context, Result};
+use hooke_core::{Num, Vec3};
 use hooke_scene::Scene;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -32,14 +32,14 @@ impl ObjExport {
     /// Prepares the folder `dir` (created if missing; refused if it is a file) for `scene`,
     /// whose collider surfaces are computed here once.
     pub fn new(dir: &Path, scene: &Scene) -> Result<Self> {
-        if dir.exists() && !dir.is_dir() {
-            bail!(
-                "--export-obj: {} is a file, expected a folder",
+        let removed = crate::output::prepare_frame_folder(dir, "--export-obj", "obj")?;
+        if removed > 0 {
+            eprintln!(
+                "--export-obj: removed {removed} frame{} of an earlier run from {}",
+                if removed == 1 { "" } else { "s" },
                 dir.display()
             );
         }
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("cannot create export folder {}", dir.display()))?;
         let x = &scene.simulation.particles().x;
         let (lo, hi) = x.iter().fold(
             (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
@@ -82,7 +82,7 @@ impl ObjExport {
 
     /// The file of frame `frame`.
     pub fn path(&self, frame: u64) -> PathBuf {
-        self.dir.join(format!("frame-{frame:05}.obj"))
+        self.dir.join(crate::output::frame_name(frame, "obj"))
     }
 
     /// Writes frame `frame` of `scene` at its current state.
@@ -107,11 +107,12 @@ fn write_frame(
         w,
         "# hooke: scene {}, frame {frame}, t = {} s, metres, +Y up",
         scene.spec.name,
-        sim.time()
+        Num(sim.time())
     )?;
     // OBJ indices are 1-based and count every vertex written so far in the file.
     let mut base = 1usize;
-    let vertex = |w: &mut dyn Write, p: &Vec3| writeln!(w, "v {} {} {}", p.x, p.y, p.z);
+    let vertex =
+        |w: &mut dyn Write, p: &Vec3| writeln!(w, "v {} {} {}", Num(p.x), Num(p.y), Num(p.z));
     for body in &scene.bodies {
         writeln!(w, "o body:{}", body.name)?;
         for p in &x[body.range.clone()] {

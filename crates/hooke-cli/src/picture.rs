@@ -1,39 +1,62 @@
 //! `hooke render` and `hooke demo`.
 
 use crate::RenderArgs;
-use crate::image_out::{View, write_gif, write_png};
-use crate::run::drive;
+use crate::image_out::{GifWriter, View, write_png};
 use crate::source;
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
+use hooke_cli::driver::{advance, drive};
+use hooke_cli::output::{check_output_file, frame_name, prepare_frame_folder};
 use hooke_cli::stills::{still_scene, still_view};
+use hooke_core::Num;
+use hooke_scene::Overrides;
+use hooke_scene::Scene;
 use hooke_scene::builtin::BUILTINS;
-use hooke_scene::{Overrides, Scene};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-/// Runs `scene` for `steps` steps (frames ignored), stopping on divergence.
-fn advance(scene: &mut Scene, steps: u64) -> Result<()> {
-    scene.steps = steps;
-    scene.every = steps.max(1);
-    drive(scene, |_, _| Ok(()))
-}
+/// The most steps `render --at` takes: beyond this a still is years of computing away.
+const MAX_RENDER_STEPS: f64 = 1e12;
+
+/// Runs from here on say how many steps they take before starting.
+const ANNOUNCE_STEPS: u64 = 1_000_000;
 
 pub fn render(args: &RenderArgs) -> Result<ExitCode> {
-    let mut scene = source::build(&args.scene, &args.setup.overrides())?;
+    check_output_file(&args.output, "-o", &["png"])?;
+    let mut scene = source::build(&args.scene, &args.setup.overrides()?)?;
     let dt = scene.simulation.dt();
     let steps = match args.at {
-        Some(t) if t.is_finite() && t >= 0.0 => (t / dt).round() as u64,
-        Some(t) => anyhow::bail!("--at: expected a time in seconds >= 0, found {t}"),
+        Some(t) if t.is_finite() && t >= 0.0 => {
+            let steps = (t / dt).round();
+            if steps > MAX_RENDER_STEPS {
+                bail!(
+                    "--at {} s is {steps:.1e} steps of dt = {} s, more than the \
+                     {MAX_RENDER_STEPS:.0e} a still may take; choose an earlier time or a larger \
+                     --dt",
+                    Num(t),
+                    Num(dt),
+                );
+            }
+            steps as u64
+        }
+        Some(t) => bail!("--at: expected a time in seconds >= 0, found {}", Num(t)),
         None => scene.steps,
     };
+    if steps >= ANNOUNCE_STEPS {
+        eprintln!(
+            "{}: t = {} s is {steps} steps of {} s (Ctrl-C stops)",
+            scene.spec.name,
+            Num(steps as f64 * dt),
+            Num(dt)
+        );
+    }
     advance(&mut scene, steps)?;
     let camera = args.view.camera(&scene);
     write_png(&args.output, &args.view.pixels(&scene, &camera))?;
     eprintln!(
         "{}: t = {} s -> {}",
         scene.spec.name,
-        scene.simulation.time(),
+        Num(scene.simulation.time()),
         args.output.display()
     );
     Ok(ExitCode::SUCCESS)
@@ -43,8 +66,11 @@ pub fn render(args: &RenderArgs) -> Result<ExitCode> {
 const ANIMATED: (&str, f64) = ("hanging-cloth", 0.1);
 
 pub fn demo(out: &Path, view: &View) -> Result<ExitCode> {
+    if out.exists() && !out.is_dir() {
+        bail!("--out {}: is a file, expected a folder", out.display());
+    }
     std::fs::create_dir_all(out)
-        .with_context(|| format!("cannot create output folder {}", out.display()))?;
+        .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
     let mut written: Vec<PathBuf> = Vec::new();
     for (k, (name, _)) in BUILTINS.iter().enumerate() {
         let started = Instant::now();
@@ -56,7 +82,7 @@ pub fn demo(out: &Path, view: &View) -> Result<ExitCode> {
         write_png(&path, &view.pixels(&scene, &camera))?;
         eprintln!(
             "{name:<14} {} s simulated in {:.2} s, still rendered in {:.2} s -> {}",
-            scene.simulation.time(),
+            Num(scene.simulation.time()),
             simulated.as_secs_f64(),
             (started.elapsed() - simulated).as_secs_f64(),
             path.display()
@@ -88,14 +114,13 @@ fn animate(
         supersample: 1,
         ..view.clone()
     };
-    let mut frames = Vec::new();
-    drive(&mut scene, |_, scene| {
-        frames.push(small.pixels(scene, camera));
-        Ok(())
-    })?;
     let path = out.join(format!("{name}.gif"));
-    let count = frames.len();
-    write_gif(&path, frames, (interval * 1000.0).round() as u32)?;
+    let mut gif = GifWriter::create(&path, small.size, (interval * 1000.0).round() as u32)?;
+    drive(&mut scene, |_, scene| {
+        gif.frame(small.pixels(scene, camera))
+    })?;
+    let count = gif.frames();
+    gif.finish()?;
     eprintln!(
         "{name:<14} animation of {count} frames -> {}",
         path.display()
@@ -103,17 +128,17 @@ fn animate(
     Ok(path)
 }
 
-/// Writes frames of a run as numbered PNGs and optionally a GIF.
+/// Writes frames of a run as numbered PNGs and optionally a GIF, each as it comes.
 pub struct FrameSink {
     dir: Option<PathBuf>,
-    gif: Option<PathBuf>,
+    gif: Option<GifWriter>,
     view: View,
     camera: Option<hooke_render::Camera>,
-    frames: Vec<image::RgbaImage>,
-    frame_ms: u32,
 }
 
 impl FrameSink {
+    /// Checks and prepares the outputs before a run: the frame folder is created and
+    /// cleared of an earlier run's frames, the GIF started.
     pub fn new(
         dir: Option<PathBuf>,
         gif: Option<PathBuf>,
@@ -124,17 +149,28 @@ impl FrameSink {
             return Ok(None);
         }
         if let Some(d) = &dir {
-            std::fs::create_dir_all(d)
-                .with_context(|| format!("cannot create frame folder {}", d.display()))?;
+            let removed = prepare_frame_folder(d, "--frames", "png")?;
+            if removed > 0 {
+                eprintln!(
+                    "--frames: removed {removed} frame{} of an earlier run from {}",
+                    if removed == 1 { "" } else { "s" },
+                    d.display()
+                );
+            }
         }
-        let frame_ms = (frame_seconds * 1000.0).round().clamp(10.0, 10_000.0) as u32;
+        let gif = match &gif {
+            Some(path) => {
+                check_output_file(path, "--gif", &["gif"])?;
+                let frame_ms = (frame_seconds * 1000.0).round().clamp(10.0, 655_350.0) as u32;
+                Some(GifWriter::create(path, view.size, frame_ms)?)
+            }
+            None => None,
+        };
         Ok(Some(Self {
             dir,
             gif,
             view,
             camera: None,
-            frames: Vec::new(),
-            frame_ms,
         }))
     }
 
@@ -147,18 +183,19 @@ impl FrameSink {
         });
         let image = self.view.pixels(scene, &camera);
         if let Some(d) = &self.dir {
-            write_png(&d.join(format!("frame-{frame:05}.png")), &image)?;
+            write_png(&d.join(frame_name(frame, "png")), &image)?;
         }
-        if self.gif.is_some() {
-            self.frames.push(image);
+        if let Some(g) = self.gif.as_mut() {
+            g.frame(image)?;
         }
         Ok(())
     }
 
+    /// Puts the GIF in place.
     pub fn finish(self) -> Result<()> {
-        if let Some(g) = &self.gif {
-            write_gif(g, self.frames, self.frame_ms)?;
+        match self.gif {
+            Some(g) => g.finish(),
+            None => Ok(()),
         }
-        Ok(())
     }
 }

@@ -4,65 +4,17 @@ use crate::source;
 use crate::trajectory::TrajectoryWriter;
 use crate::{RunArgs, SetupArgs};
 use anyhow::{Context, Result, bail};
-use hooke_cli::interrupt::{self, Interrupted};
+use hooke_cli::driver::drive;
+use hooke_cli::interrupt::{self, is_interrupt};
+use hooke_cli::output::check_output_file;
+use hooke_core::Num;
 use hooke_core::{Divergence, Integrator, StabilityEstimate, Summary};
-use hooke_scene::Scene;
-use indicatif::{ProgressBar, ProgressStyle};
-use std::io::IsTerminal;
+use hooke_scene::{Overrides, Scene};
 use std::path::Path;
 use std::process::ExitCode;
 
-/// Steps `scene` to its end, calling `on_frame(frame, scene)` at frame 0 and after every
-/// `every` steps. A divergence comes back as an error holding a [`Divergence`].
-pub fn drive(scene: &mut Scene, mut on_frame: impl FnMut(u64, &Scene) -> Result<()>) -> Result<()> {
-    let (steps, every) = (scene.steps, scene.every);
-    let progress = if std::io::stderr().is_terminal() && steps >= 10_000 {
-        let bar = ProgressBar::new(steps);
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{prefix} [{bar:40}] {pos}/{len} steps, {elapsed} elapsed, eta {eta}",
-            )
-            .expect("valid template")
-            .progress_chars("=> "),
-        );
-        bar.set_prefix(scene.spec.name.clone());
-        bar
-    } else {
-        ProgressBar::hidden()
-    };
-    // Steps one at a time so that Ctrl-C is answered within a step, not a frame.
-    let advance = |scene: &mut Scene, n: u64| -> Result<()> {
-        for _ in 0..n {
-            if interrupt::requested() {
-                let sim = &scene.simulation;
-                return Err(Interrupted {
-                    step: sim.steps(),
-                    time: sim.time(),
-                }
-                .into());
-            }
-            scene.simulation.step()?;
-        }
-        Ok(())
-    };
-    on_frame(0, scene)?;
-    for frame in 1..=steps / every {
-        advance(scene, every)?;
-        on_frame(frame, scene)?;
-        progress.set_position(scene.simulation.steps());
-    }
-    // Steps past the last full frame are still run: the run's length is what was asked for.
-    advance(scene, steps % every)?;
-    progress.finish_and_clear();
-    Ok(())
-}
-
 fn is_divergence(e: &anyhow::Error) -> bool {
     e.downcast_ref::<Divergence>().is_some()
-}
-
-fn is_interrupt(e: &anyhow::Error) -> bool {
-    e.downcast_ref::<Interrupted>().is_some()
 }
 
 /// Warns on stderr when the scene's step exceeds the estimated stable step.
@@ -73,7 +25,7 @@ fn warn_if_unstable(scene: &Scene) -> StabilityEstimate {
     if sim.dt() > limit {
         eprintln!(
             "warning: dt = {} s exceeds the estimated stable step of {} ({limit:.3e} s, ω_max = {:.4e} rad/s); the run may diverge",
-            sim.dt(),
+            Num(sim.dt()),
             sim.integrator(),
             estimate.omega_max
         );
@@ -103,7 +55,9 @@ fn tunnelling(scene: &Scene) -> Vec<Tunnelling> {
         .colliders
         .iter()
         .filter_map(|slot| {
-            let thickness = slot.shape.thickness()?;
+            // A collider without thickness (an open sheet) is held by the crossing test,
+            // not by depth: nothing to tunnel through.
+            let thickness = slot.shape.thickness().filter(|t| *t > 0.0)?;
             Some(Tunnelling {
                 collider: slot.shape.name(),
                 thickness,
@@ -128,12 +82,13 @@ impl Tunnelling {
     fn describe(&self, dt: f64) -> String {
         format!(
             "{} is {:.1} mm thick at its thinnest; at {:.2} m/s (a fall of {:.2} m) a particle moves \
-             {:.1} mm per step of {dt} s",
+             {:.1} mm per step of {} s",
             self.collider,
             self.thickness * 1e3,
             self.speed,
             self.drop,
-            self.per_step * 1e3
+            self.per_step * 1e3,
+            Num(dt)
         )
     }
 }
@@ -168,12 +123,13 @@ fn thin_surfaces(scene: &Scene) -> Vec<String> {
         .filter(|b| b.thickness > 0.0 && 2.0 * speed * dt > b.thickness)
         .map(|b| {
             format!(
-                "body '{}': two layers closing at {:.2} m/s move {:.1} mm per step of {dt} s, more \
+                "body '{}': two layers closing at {:.2} m/s move {:.1} mm per step of {} s, more \
                  than its contact thickness of {:.1} mm, so they can cross unseen; use dt below \
                  {:.3e} s or a larger thickness",
                 b.name,
                 2.0 * speed,
                 2.0 * speed * dt * 1e3,
+                Num(dt),
                 b.thickness * 1e3,
                 b.thickness / (2.0 * speed)
             )
@@ -198,7 +154,29 @@ fn warn_if_tunnelling(scene: &Scene) {
 }
 
 pub fn run(args: &RunArgs) -> Result<ExitCode> {
-    let mut scene = source::build(&args.scene, &args.setup.overrides())?;
+    // Every output is checked before the scene is built and run.
+    if let Some(path) = &args.trajectory {
+        check_output_file(path, "--trajectory", &[])?;
+    }
+    if let Some(path) = &args.gif {
+        check_output_file(path, "--gif", &["gif"])?;
+    }
+    for (dir, flag) in [
+        (&args.frames, "--frames"),
+        (&args.export_obj, "--export-obj"),
+    ] {
+        if let Some(dir) = dir
+            && dir.exists()
+            && !dir.is_dir()
+        {
+            bail!("{flag} {}: is a file, expected a folder", dir.display());
+        }
+    }
+    let overrides = Overrides {
+        every: args.every,
+        ..args.setup.overrides()?
+    };
+    let mut scene = source::build(&args.scene, &overrides)?;
     warn_if_unstable(&scene);
     warn_if_tunnelling(&scene);
     let mut trajectory = args
@@ -284,24 +262,25 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         "{}: {} steps of {} s with {} ({} s simulated), {} particles, {} springs",
         scene.spec.name,
         sim.steps(),
-        sim.dt(),
+        Num(sim.dt()),
         sim.integrator(),
-        sim.time(),
+        Num(sim.time()),
         sim.particles().len(),
         sim.model().springs.len()
     );
     if let Some(path) = &args.trajectory {
+        let frames = scene.steps / every + 1;
         eprintln!(
-            "trajectory: {} ({} frames)",
+            "trajectory: {} ({frames} frame{})",
             path.display(),
-            scene.steps / every + 1
+            if frames == 1 { "" } else { "s" }
         );
     }
     Ok(ExitCode::SUCCESS)
 }
 
 pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
-    let scene = source::build(arg, &setup.overrides())?;
+    let scene = source::build(arg, &setup.overrides()?)?;
     let sim = &scene.simulation;
     let estimate = warn_if_unstable(&scene);
     println!(
@@ -314,7 +293,11 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
         "highest angular frequency ω_max ≈ {:.4e} rad/s (power iteration on M⁻¹K)",
         estimate.omega_max
     );
-    println!("scene step: dt = {} s with {}", sim.dt(), sim.integrator());
+    println!(
+        "scene step: dt = {} s with {}",
+        Num(sim.dt()),
+        sim.integrator()
+    );
     for integrator in Integrator::ALL {
         let limit = estimate.max_dt(integrator);
         let mark = if integrator == sim.integrator() {
@@ -322,23 +305,17 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
         } else {
             ""
         };
-        let note = match integrator {
-            Integrator::Euler | Integrator::Midpoint => {
-                " (needs damping: amplifies undamped oscillation at any dt)"
+        let line = match integrator {
+            _ if !limit.is_finite() => {
+                "stable for any dt (accuracy still wants small steps)".to_string()
             }
-            _ => "",
+            // Their amplification factor exceeds 1 for every undamped mode at every dt.
+            Integrator::Euler | Integrator::Midpoint => format!(
+                "grows undamped oscillation at any dt; with enough damping, dt < {limit:.3e} s"
+            ),
+            _ => format!("stable for dt < {limit:.3e} s"),
         };
-        if limit.is_finite() {
-            println!(
-                "  {:<11} stable for dt < {limit:.3e} s{note}{mark}",
-                integrator.name()
-            );
-        } else {
-            println!(
-                "  {:<11} stable for any dt (accuracy still wants small steps){mark}",
-                integrator.name()
-            );
-        }
+        println!("  {:<11} {line}{mark}", integrator.name());
     }
     let dt = sim.dt();
     for t in tunnelling(&scene) {

@@ -3,6 +3,8 @@
 use anyhow::{Context, Result, bail};
 use hooke_scene::builtin::BUILTINS;
 use hooke_scene::{Overrides, Scene, SceneSpec};
+use indicatif::ProgressBar;
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 /// Where a scene came from.
@@ -47,14 +49,44 @@ fn stem(path: &Path) -> String {
         .map_or_else(|| "world".into(), |s| s.to_string_lossy().into_owned())
 }
 
-/// Reads and builds the scene named by `arg` with command-line overrides.
+/// Builds larger than this show a spinner (on a terminal) or say that they take a while.
+const ANNOUNCE_BYTES: u64 = 256 << 20;
+
+/// Reads and builds the scene named by `arg` with command-line overrides. A scene whose
+/// estimated memory exceeds the budget ([`crate::memory`]) is refused before it is built.
 pub fn build(arg: &str, overrides: &Overrides) -> Result<Scene> {
     let mut source = read(arg)?;
     overrides
         .apply(&mut source.spec)
         .with_context(|| format!("scene '{arg}'"))?;
-    source
+    let footprint = source.spec.footprint(&source.base);
+    crate::memory::check(arg, &footprint)?;
+    let large = footprint.bytes() >= ANNOUNCE_BYTES;
+    let spinner = if large && std::io::stderr().is_terminal() {
+        let bar = ProgressBar::new_spinner();
+        bar.set_message(format!(
+            "building scene '{arg}': {} particles, {} springs, about {}",
+            footprint.particles,
+            footprint.springs,
+            crate::memory::human(footprint.bytes())
+        ));
+        bar.enable_steady_tick(std::time::Duration::from_millis(120));
+        bar
+    } else {
+        if large {
+            eprintln!(
+                "building scene '{arg}': {} particles, {} springs, about {}; this takes a while",
+                footprint.particles,
+                footprint.springs,
+                crate::memory::human(footprint.bytes())
+            );
+        }
+        ProgressBar::hidden()
+    };
+    let scene = source
         .spec
         .build(&source.base)
-        .with_context(|| format!("scene '{arg}'"))
+        .with_context(|| format!("scene '{arg}'"));
+    spinner.finish_and_clear();
+    scene
 }

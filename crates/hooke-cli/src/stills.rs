@@ -18,7 +18,7 @@ pub fn still_scene(name: &str) -> Result<Scene> {
         None => scene.steps,
     };
     scene.steps = steps;
-    scene.simulation.advance(steps)?;
+    crate::driver::advance(&mut scene, steps)?;
     Ok(scene)
 }
 

@@ -1,9 +1,9 @@
-//! Trajectory CSV (docs/physics.md §6): `frame,time,particle,x,y,z,vx,vy,vz`, numbers in Rust's
-//! shortest round-trip form.
+//! Trajectory CSV (docs/physics.md §6): `frame,time,particle,x,y,z,vx,vy,vz`, numbers in
+//! their shortest round-trip form ([`hooke_core::Num`]: scientific far from 1).
 
 use crate::output::AtomicFile;
 use anyhow::{Context, Result};
-use hooke_core::Particles;
+use hooke_core::{Num, Particles};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -34,8 +34,14 @@ impl TrajectoryWriter {
         for (i, (x, v)) in p.x.iter().zip(&p.v).enumerate() {
             writeln!(
                 w,
-                "{frame},{time},{i},{},{},{},{},{},{}",
-                x.x, x.y, x.z, v.x, v.y, v.z
+                "{frame},{},{i},{},{},{},{},{},{}",
+                Num(time),
+                Num(x.x),
+                Num(x.y),
+                Num(x.z),
+                Num(v.x),
+                Num(v.y),
+                Num(v.z)
             )
             .with_context(|| format!("cannot write {}", self.path.display()))?;
         }

@@ -153,7 +153,7 @@ fn bad_input_is_refused_with_the_file_and_line_and_writes_nothing() {
         ),
         (
             &["run", "chain", "--dt", "-1", "--trajectory", "t.csv"],
-            "--dt: expected a finite number > 0, found -1",
+            "'--dt <DT>': expected a time in seconds > 0, found '-1'",
         ),
         (
             &[
@@ -207,7 +207,7 @@ fn divergence_names_the_step_and_particle_and_keeps_complete_frames() {
     assert!(!out.status.success());
     let e = stderr(&out);
     assert!(
-        e.contains("diverged at step") && e.contains("particle") && e.contains("try --dt"),
+        e.contains("diverged at step") && e.contains("particle") && e.contains("use dt = "),
         "{e}"
     );
     let text = std::fs::read_to_string(dir.join("t.csv")).unwrap();

@@ -95,7 +95,11 @@ fn exists(root: &Path, file: &Path, mention: &str) -> bool {
 fn help_texts() -> Vec<(String, String)> {
     let hooke = env!("CARGO_BIN_EXE_hooke");
     let help = |args: &[&str]| {
-        let out = Command::new(hooke).args(args).arg("--help").output().unwrap();
+        let out = Command::new(hooke)
+            .args(args)
+            .arg("--help")
+            .output()
+            .unwrap();
         assert!(out.status.success(), "hooke {args:?} --help failed");
         String::from_utf8(out.stdout).unwrap()
     };
@@ -144,7 +148,10 @@ fn every_mentioned_repository_path_exists() {
         for m in mentions {
             checked += 1;
             if !exists(&root, file, &m) {
-                missing.push(format!("{}: {m}", file.strip_prefix(&root).unwrap().display()));
+                missing.push(format!(
+                    "{}: {m}",
+                    file.strip_prefix(&root).unwrap().display()
+                ));
             }
         }
     }

@@ -1,0 +1,498 @@
+//! What an unlucky or hostile user does to `hooke`: interrupts it (twice), points its output
+//! at folders and missing places, hands it numbers no scene can use, asks for scenes larger
+//! than the machine, records long animations. Each case gets a clear refusal or a correct
+//! result; nothing is lost, nothing is left behind, nothing panics.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn hooke_in(dir: &Path) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_hooke"));
+    c.current_dir(dir);
+    c
+}
+
+fn hooke(args: &[&str], dir: &Path) -> Output {
+    hooke_in(dir).args(args).output().unwrap()
+}
+
+fn spawn(args: &[&str], dir: &Path) -> Child {
+    hooke_in(dir)
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("hooke-robust-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn interrupt(child: &Child) {
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+}
+
+/// Files under `dir` (recursively) whose names mark an unfinished write.
+fn temporaries(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap().flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            out.extend(temporaries(&path));
+        } else if path.to_string_lossy().ends_with(".tmp") {
+            out.push(path);
+        }
+    }
+    out
+}
+
+/// Waits until `ready()` or panics after a minute (a slow machine, not a hang, is expected).
+fn wait_for(what: &str, mut ready: impl FnMut() -> bool) {
+    let start = Instant::now();
+    while !ready() {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "timed out waiting for {what}"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+fn count_files(dir: &Path, ext: &str) -> usize {
+    std::fs::read_dir(dir).map_or(0, |d| {
+        d.flatten()
+            .filter(|e| e.path().extension().is_some_and(|x| x == ext))
+            .count()
+    })
+}
+
+fn gif_frames(path: &Path) -> usize {
+    use image::AnimationDecoder;
+    let file = std::io::BufReader::new(std::fs::File::open(path).unwrap());
+    image::codecs::gif::GifDecoder::new(file)
+        .unwrap()
+        .into_frames()
+        .collect_frames()
+        .unwrap()
+        .len()
+}
+
+/// Two interrupts in a row (what `timeout` and an impatient user send) stop the run at a
+/// complete frame: the trajectory, the frame folder and the GIF all end at the same frame,
+/// the exit status is 130 and no temporary file remains. Repeated at different moments,
+/// since the failure this guards against was a race.
+#[test]
+fn two_interrupts_keep_every_complete_frame() {
+    const PARTICLES: usize = 625; // hanging-cloth
+    for round in 0..4u64 {
+        let dir = scratch(&format!("twice-{round}"));
+        let child = spawn(
+            &[
+                "run",
+                "hanging-cloth",
+                "--steps",
+                "100000000",
+                "--every",
+                "10",
+                "--trajectory",
+                "t.csv",
+                "--frames",
+                "f",
+                "--gif",
+                "a.gif",
+                "--size",
+                "64x48",
+            ],
+            &dir,
+        );
+        wait_for("frames", || count_files(&dir.join("f"), "png") >= 3);
+        std::thread::sleep(Duration::from_millis(37 * round));
+        interrupt(&child);
+        interrupt(&child);
+        let out = child.wait_with_output().unwrap();
+        assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
+        let csv = std::fs::read_to_string(dir.join("t.csv")).unwrap();
+        let rows = csv.lines().count() - 1;
+        assert!(rows >= 3 * PARTICLES, "round {round}: {rows} rows");
+        assert_eq!(rows % PARTICLES, 0, "round {round}: a partial frame");
+        let frames = rows / PARTICLES;
+        assert_eq!(count_files(&dir.join("f"), "png"), frames, "round {round}");
+        assert_eq!(gif_frames(&dir.join("a.gif")), frames, "round {round}");
+        assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
+
+/// `render` and `demo` stop on Ctrl-C with the same status as `run`, writing no partial
+/// image and leaving no temporary file.
+#[test]
+fn render_and_demo_stop_on_interrupt_with_status_130() {
+    let dir = scratch("render-int");
+    for (args, started) in [
+        (
+            &["render", "chain", "--at", "1e6", "-o", "z.png"][..],
+            700u64,
+        ),
+        (&["demo", "--out", "d"][..], 1500),
+    ] {
+        let child = spawn(args, &dir);
+        std::thread::sleep(Duration::from_millis(started));
+        interrupt(&child);
+        let out = child.wait_with_output().unwrap();
+        assert_eq!(out.status.code(), Some(130), "{args:?}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains("interrupted at step"),
+            "{}",
+            stderr(&out)
+        );
+    }
+    assert!(!dir.join("z.png").exists());
+    assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Output paths that cannot take the file are refused before a (here endless) run starts,
+/// and no temporary file appears, neither beside the target nor in its parent.
+#[test]
+fn unusable_output_paths_are_refused_before_the_run() {
+    let dir = scratch("paths");
+    std::fs::write(dir.join("file.txt"), "mine").unwrap();
+    std::fs::create_dir_all(dir.join("out")).unwrap();
+    let here = dir.to_string_lossy().into_owned();
+    let endless = ["run", "chain", "--steps", "1000000000"];
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--trajectory", &here], "is a folder"),
+        (vec!["--trajectory", "out/"], "is a folder"),
+        (vec!["--trajectory", "out"], "is a folder"),
+        (vec!["--trajectory", "missing/t.csv"], "does not exist"),
+        (vec!["--gif", "a.png"], "ending in .gif"),
+        (vec!["--gif", "out"], "is a folder"),
+        (vec!["--frames", "file.txt"], "expected a folder"),
+        (vec!["--export-obj", "file.txt"], "expected a folder"),
+    ];
+    for (extra, expect) in cases {
+        let args: Vec<&str> = endless.iter().copied().chain(extra).collect();
+        let out = hooke(&args, &dir);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        assert!(stderr(&out).contains(expect), "{args:?}: {}", stderr(&out));
+    }
+    for (output, expect) in [
+        ("z.jpg", "ending in .png"),
+        ("out", "is a folder"),
+        (".", "is a folder"),
+        ("missing/z.png", "does not exist"),
+    ] {
+        let out = hooke(&["render", "chain", "--at", "1e5", "-o", output], &dir);
+        assert_eq!(out.status.code(), Some(1), "{output}");
+        assert!(stderr(&out).contains(expect), "{output}: {}", stderr(&out));
+    }
+    let out = hooke(&["demo", "--out", "file.txt"], &dir);
+    assert!(
+        stderr(&out).contains("expected a folder"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["file.txt", "out"]);
+    assert_eq!(count_files(&dir.join("out"), "tmp"), 0);
+    // `--trajectory DIR` would have written `.DIR.<pid>.tmp` into DIR's parent.
+    let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+    let parent_leftovers: Vec<_> = std::fs::read_dir(dir.parent().unwrap())
+        .unwrap()
+        .flatten()
+        .filter(|e| {
+            e.file_name()
+                .to_string_lossy()
+                .starts_with(&format!(".{name}."))
+        })
+        .collect();
+    assert!(parent_leftovers.is_empty(), "{parent_leftovers:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Numbers no picture or scene can use are refused where they enter, naming the option or
+/// the file and line, with no panic and no output file.
+#[test]
+fn bad_numbers_are_refused_without_a_panic() {
+    let dir = scratch("numbers");
+    std::fs::write(
+        dir.join("far.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 0 1e200\nf 1 2 3\n",
+    )
+    .unwrap();
+    let scene = hooke(&["scene", "single-spring"], &dir);
+    let text = String::from_utf8(scene.stdout).unwrap();
+    let far: String = text
+        .lines()
+        .map(|l| match l.starts_with("origin = ") {
+            true => "origin = [1e300, 0.0, 0.0]\n".to_string(),
+            false => format!("{l}\n"),
+        })
+        .collect();
+    assert!(far.contains("1e300"));
+    std::fs::write(dir.join("far.toml"), far).unwrap();
+    let render = |extra: &[&'static str]| -> Vec<&'static str> {
+        let mut v = vec!["render", "chain", "-o", "z.png"];
+        v.extend_from_slice(extra);
+        v
+    };
+    let run = |extra: &[&'static str]| -> Vec<&'static str> {
+        let mut v = vec!["run", "chain", "--trajectory", "t.csv"];
+        v.extend_from_slice(extra);
+        v
+    };
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (render(&["--zoom", "0"]), "--zoom"),
+        (render(&["--zoom", "nan"]), "--zoom"),
+        (render(&["--zoom", "-1"]), "--zoom"),
+        (render(&["--zoom", "inf"]), "--zoom"),
+        (render(&["--yaw", "nan"]), "--yaw"),
+        (render(&["--pitch", "90"]), "--pitch"),
+        (render(&["--supersample", "0"]), "--supersample"),
+        (render(&["--supersample", "100"]), "--supersample"),
+        (render(&["--size", "0x0"]), "--size"),
+        (render(&["--at", "1e300"]), "--at 1e300 s"),
+        (render(&["--at", "-1"]), "--at"),
+        (render(&["--at", "nan"]), "--at"),
+        (run(&["--zoom", "0", "--frames", "d"]), "--zoom"),
+        (run(&["--dt", "nan"]), "--dt"),
+        (run(&["--dt", "0"]), "--dt"),
+        (run(&["--dt", "-1"]), "--dt"),
+        (run(&["--dt", "1e300"]), "less than one step"),
+        (run(&["--duration", "1e300"]), "1e300 s"),
+        (run(&["--steps", "0"]), "--steps"),
+        (run(&["--every", "0"]), "--every"),
+        (
+            vec![
+                "run",
+                "cloth-table",
+                "--table",
+                "far.obj",
+                "--trajectory",
+                "t.csv",
+            ],
+            "far.obj:3: vertex coordinate 1e200 is beyond",
+        ),
+        (vec!["run", "far.toml", "--trajectory", "t.csv"], "origin"),
+    ];
+    for (args, expect) in cases {
+        let out = hooke(&args, &dir);
+        let e = stderr(&out);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(!e.contains("panicked"), "{args:?}: {e}");
+        assert!(e.contains(expect), "{args:?}: expected '{expect}' in: {e}");
+        // Numbers far from 1 print in scientific form, not as hundreds of digits.
+        assert!(e.lines().all(|l| l.chars().count() < 400), "{args:?}: {e}");
+    }
+    assert!(!dir.join("z.png").exists() && !dir.join("t.csv").exists());
+    let out = hooke_in(&dir)
+        .args(["run", "chain", "--steps", "1"])
+        .env("HOOKE_MAX_MEMORY", "lots")
+        .output()
+        .unwrap();
+    assert!(
+        stderr(&out).contains("HOOKE_MAX_MEMORY=lots"),
+        "{}",
+        stderr(&out)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A small scene file asking for the largest lattice is refused in a moment when it would
+/// exceed the memory budget, with what it needs and the key to change; within the budget
+/// the same machinery lets ordinary scenes through.
+#[test]
+fn scenes_larger_than_the_memory_budget_are_refused_before_building() {
+    let dir = scratch("memory");
+    let scene = hooke(&["scene", "jello-cube"], &dir);
+    let text = String::from_utf8(scene.stdout).unwrap();
+    assert!(text.contains("size = [8, 8, 8]"));
+    std::fs::write(
+        dir.join("huge.toml"),
+        text.replace("size = [8, 8, 8]", "size = [161, 161, 161]"),
+    )
+    .unwrap();
+    let out = hooke_in(&dir)
+        .args(["run", "huge.toml", "--trajectory", "t.csv"])
+        .env("HOOKE_MAX_MEMORY", "1G")
+        .output()
+        .unwrap();
+    let e = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    for expect in [
+        "would need about",
+        "4173281 particles",
+        "1.0 GB of HOOKE_MAX_MEMORY",
+        "body[0] 'jelly'.shape.size",
+    ] {
+        assert!(e.contains(expect), "expected '{expect}' in: {e}");
+    }
+    assert!(!dir.join("t.csv").exists());
+    let out = hooke_in(&dir)
+        .args(["run", "jello-cube", "--steps", "10"])
+        .env("HOOKE_MAX_MEMORY", "1G")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The GIF is encoded frame by frame: after hundreds of 400×300 frames (half a megabyte
+/// each as pixels) the process's peak memory is still a fraction of what holding them would
+/// take, and the GIF it leaves on Ctrl-C has every frame the folder has.
+#[cfg(target_os = "linux")]
+#[test]
+fn gif_frames_are_encoded_as_they_come() {
+    const FRAMES: usize = 300;
+    const FRAME_BYTES: usize = 400 * 300 * 4;
+    let dir = scratch("gif");
+    let child = spawn(
+        &[
+            "run",
+            "chain",
+            "--steps",
+            "1000000000",
+            "--every",
+            "1",
+            "--size",
+            "400x300",
+            "--supersample",
+            "1",
+            "--frames",
+            "f",
+            "--gif",
+            "a.gif",
+        ],
+        &dir,
+    );
+    let peak_kb = || -> usize {
+        let status = std::fs::read_to_string(format!("/proc/{}/status", child.id())).unwrap();
+        let line = status.lines().find(|l| l.starts_with("VmHWM:")).unwrap();
+        line.split_whitespace().nth(1).unwrap().parse().unwrap()
+    };
+    wait_for("frames", || count_files(&dir.join("f"), "png") >= FRAMES);
+    let peak = peak_kb() * 1024;
+    interrupt(&child);
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
+    let held = FRAMES * FRAME_BYTES;
+    assert!(
+        peak * 3 < held,
+        "peak {peak} bytes after {FRAMES} frames: frames are being held ({held} bytes)"
+    );
+    let frames = count_files(&dir.join("f"), "png");
+    assert_eq!(gif_frames(&dir.join("a.gif")), frames);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Small things a user notices: stale frames of a longer earlier run are cleared from a
+/// frame folder, "1 frame" is singular, a `--table` path is relative to where the command
+/// runs (not to the scene file), tiny numbers in a trajectory are short.
+#[test]
+fn frame_folders_plurals_table_paths_and_tiny_numbers() {
+    let dir = scratch("small");
+    let run = |args: &[&str]| {
+        let out = hooke(args, &dir);
+        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+        stderr(&out)
+    };
+    run(&[
+        "run", "chain", "--steps", "100", "--every", "10", "--frames", "f", "--size", "32x24",
+    ]);
+    assert_eq!(count_files(&dir.join("f"), "png"), 11);
+    std::fs::write(dir.join("f/notes.png.txt"), "mine").unwrap();
+    let e = run(&[
+        "run", "chain", "--steps", "40", "--every", "10", "--frames", "f", "--size", "32x24",
+    ]);
+    assert!(e.contains("removed 11 frames"), "{e}");
+    assert_eq!(count_files(&dir.join("f"), "png"), 5);
+    assert!(
+        dir.join("f/notes.png.txt").exists(),
+        "only frames are removed"
+    );
+
+    let e = run(&[
+        "run",
+        "chain",
+        "--steps",
+        "5",
+        "--every",
+        "10",
+        "--trajectory",
+        "t.csv",
+    ]);
+    assert!(e.contains("(1 frame)"), "{e}");
+
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    let scene = hooke(&["scene", "cloth-table"], &dir);
+    std::fs::write(dir.join("sub/mine.toml"), scene.stdout).unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/meshes");
+    std::fs::copy(root.join("square-table.obj"), dir.join("t.obj")).unwrap();
+    run(&["run", "sub/mine.toml", "--table", "./t.obj", "--steps", "2"]);
+    let out = hooke(
+        &[
+            "run",
+            "sub/mine.toml",
+            "--table",
+            "sub/t.obj",
+            "--steps",
+            "2",
+        ],
+        &dir,
+    );
+    assert!(
+        stderr(&out).contains("--table sub/t.obj: no such file"),
+        "{}",
+        stderr(&out)
+    );
+
+    let single = String::from_utf8(hooke(&["scene", "single-spring"], &dir).stdout).unwrap();
+    assert!(single.contains("velocity = [0.0, 0.0, 0.0]"), "{single}");
+    std::fs::write(
+        dir.join("tiny.toml"),
+        single.replacen(
+            "velocity = [0.0, 0.0, 0.0]",
+            "velocity = [2.5e-30, 0.0, 0.0]",
+            1,
+        ),
+    )
+    .unwrap();
+    run(&[
+        "run",
+        "tiny.toml",
+        "--steps",
+        "1",
+        "--trajectory",
+        "tiny.csv",
+    ]);
+    let csv = std::fs::read_to_string(dir.join("tiny.csv")).unwrap();
+    // Particle 0 is pinned (its velocity zeroed); particle 1 keeps the tiny one.
+    let free = csv.lines().nth(2).unwrap();
+    assert!(
+        free.starts_with("0,0,1,") && free.contains(",2.5e-30,"),
+        "{free}"
+    );
+    for field in csv.lines().skip(1).flat_map(|l| l.split(',')) {
+        assert!(field.len() <= 24, "'{field}' is longer than a shortest f64");
+        field.parse::<f64>().unwrap();
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
