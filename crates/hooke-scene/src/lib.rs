@@ -25,6 +25,7 @@ pub mod footprint;
 pub mod generators;
 pub mod spec;
 pub mod surface;
+mod tagged;
 pub mod workload;
 pub mod world;
 

@@ -239,7 +239,11 @@ fn origin() -> [Finite; 3] {
 
 /// How a body's particles are laid out (in its local frame, before `rotate` and `origin`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+#[serde(
+    tag = "kind",
+    rename_all = "kebab-case",
+    try_from = "crate::tagged::ShapeTable"
+)]
 pub enum ShapeSpec {
     /// `count` particles along local +x, `spacing` apart, the first at the origin.
     Chain {
@@ -332,7 +336,11 @@ pub struct ColliderSpec {
 
 /// A collider's geometry.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+#[serde(
+    tag = "kind",
+    rename_all = "kebab-case",
+    try_from = "crate::tagged::ColliderShapeTable"
+)]
 pub enum ColliderShapeSpec {
     /// The plane `y = height`, solid below.
     Ground {
@@ -366,25 +374,22 @@ pub enum ColliderShapeSpec {
     Mesh {
         /// The OBJ file.
         path: String,
-        /// Translation, metres.
-        #[serde(default = "origin")]
+        /// Translation, metres (default zero).
         translate: [Finite; 3],
-        /// Rotation in degrees about x, then y, then z.
-        #[serde(default = "origin")]
+        /// Rotation in degrees about x, then y, then z (default zero).
         rotate: [Finite; 3],
-        /// Scale per axis.
-        #[serde(default = "unit")]
+        /// Scale per axis (default one).
         scale: [Positive; 3],
     },
 }
 
-fn unit() -> [Positive; 3] {
-    [Positive(1.0); 3]
-}
-
 /// A collision response (docs/physics.md §3.3).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+#[serde(
+    tag = "kind",
+    rename_all = "kebab-case",
+    try_from = "crate::tagged::ResponseTable"
+)]
 pub enum ResponseSpec {
     /// Penalty spring `kc δ n - dc (v·n) n`.
     Penalty {
@@ -398,15 +403,10 @@ pub enum ResponseSpec {
         /// Coefficient of restitution.
         cr: Fraction,
         /// Fraction of tangential velocity removed per contact (default 0).
-        #[serde(default = "no_friction")]
         friction: Fraction,
     },
     /// Projection and a full stop after each step.
     Stick,
-}
-
-fn no_friction() -> Fraction {
-    Fraction(0.0)
 }
 
 /// `[force_field]`: `resolution³` force vectors in newtons, in file order.
