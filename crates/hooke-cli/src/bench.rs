@@ -79,12 +79,12 @@ pub enum Bench {
         /// Image size.
         #[arg(long, default_value = "1024x1024", value_parser = crate::image_out::parse_size)]
         size: (u32, u32),
-        /// Samples per pixel along each axis (2 = 4× anti-aliasing).
-        #[arg(long, default_value_t = 2)]
+        /// Samples per pixel along each axis, 1 to 4 (2 = 4× anti-aliasing).
+        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=4))]
         supersample: u32,
-        /// Timed repetitions; the median is reported.
-        #[arg(long, default_value_t = 5)]
-        repeat: usize,
+        /// Timed repetitions, at least 1; the median is reported.
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u16).range(1..))]
+        repeat: u16,
         /// Worker threads (default: one per core).
         #[arg(long)]
         threads: Option<usize>,
@@ -262,7 +262,7 @@ pub fn run(bench: &Bench) -> Result<ExitCode> {
                 save.as_deref(),
                 *size,
                 *supersample,
-                (*repeat).max(1),
+                usize::from(*repeat),
                 *json,
             )
         }),
@@ -417,7 +417,7 @@ fn renders(
     let options = RenderOptions {
         width,
         height,
-        supersample: supersample.clamp(1, 4),
+        supersample,
         ..RenderOptions::default()
     };
     let mut scenes: Vec<(String, Scene)> = Vec::new();
@@ -426,11 +426,12 @@ fn renders(
             .strip_prefix("cloth-")
             .and_then(|n| n.parse::<usize>().ok());
         let scene = match grid {
-            Some(n) => workload(n, 1, Integrator::Symplectic)?,
+            Some(n) => workload(n, 1, Integrator::Symplectic)
+                .with_context(|| format!("target {target}"))?,
             None => {
                 let mut scene = source::build(target, &Overrides::default())?;
                 let steps = scene.steps;
-                scene.simulation.advance(steps)?;
+                hooke_cli::driver::advance(&mut scene, steps)?;
                 scene
             }
         };

@@ -99,6 +99,45 @@ impl View {
     }
 }
 
+/// The options `hooke render` takes that decide the picture, for [`picture_from_args`].
+#[derive(clap::Parser, Debug)]
+#[command(name = "render")]
+struct PictureArgs {
+    /// Built-in scene name.
+    scene: String,
+    /// Simulated time of the picture, seconds.
+    #[arg(long, allow_negative_numbers = true)]
+    at: Option<f64>,
+    #[command(flatten)]
+    view: View,
+}
+
+/// The argument-to-picture path of `hooke render`, in process and without files: `args`
+/// as on the command line after `render` (`chain --at 0.5 --zoom 2 --size 64x48`), the
+/// scene built, run to `--at` (at most `max_steps` steps, so that a fuzzer's `--at 1e9`
+/// stays quick) and drawn. Any argument is either refused with an error or gives a picture
+/// of the asked size; nothing panics. The fuzz target `args` and a property test drive it.
+pub fn picture_from_args(args: &[String], max_steps: u64) -> Result<RgbaImage> {
+    use clap::Parser;
+    let parsed = PictureArgs::try_parse_from(
+        std::iter::once("render".to_string()).chain(args.iter().cloned()),
+    )?;
+    let mut scene = crate::source::build(&parsed.scene, &hooke_scene::Overrides::default())?;
+    let steps = match parsed.at {
+        Some(t) if t.is_finite() && t >= 0.0 => {
+            (t / scene.simulation.dt()).round().min(max_steps as f64) as u64
+        }
+        Some(t) => anyhow::bail!(
+            "--at: expected a time in seconds >= 0, found {}",
+            hooke_core::Num(t)
+        ),
+        None => max_steps.min(scene.steps),
+    };
+    crate::driver::advance(&mut scene, steps)?;
+    let camera = parsed.view.camera(&scene);
+    Ok(parsed.view.pixels(&scene, &camera))
+}
+
 /// Encodes and writes a PNG atomically.
 pub fn write_png(path: &Path, image: &RgbaImage) -> Result<()> {
     let mut bytes = Vec::new();

@@ -26,13 +26,13 @@ use std::time::{Duration, Instant};
 #[derive(clap::Args)]
 pub struct ViewArgs {
     /// Scenes to cycle through with TAB: built-in names, .toml scenes or .w worlds
-    /// (default: the five built-ins).
+    /// (default: the six built-ins).
     scenes: Vec<String>,
     /// Window size as WIDTHxHEIGHT.
     #[arg(long, default_value = "800x600", value_parser = crate::image_out::parse_size)]
     size: (u32, u32),
-    /// Samples per pixel along each axis (1 = fastest, 2 = 4× anti-aliasing).
-    #[arg(long, default_value_t = 1)]
+    /// Samples per pixel along each axis, 1 to 4 (1 = fastest, 2 = 4× anti-aliasing).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4))]
     supersample: u32,
     /// Folder for screenshots (SPACE).
     #[arg(long, default_value = ".")]
@@ -326,7 +326,7 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
         .build()
         .context("cannot start the worker threads")?;
     let mut buffer = vec![0u32; w * h];
-    let options = viewer.options(size, args.supersample.clamp(1, 4));
+    let options = viewer.options(size, args.supersample);
 
     let started = Instant::now();
     let mut last = Instant::now();

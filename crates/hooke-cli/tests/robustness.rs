@@ -496,3 +496,76 @@ fn frame_folders_plurals_table_paths_and_tiny_numbers() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+mod picture_arguments {
+    use hooke_cli::image_out::{parse_size, picture_from_args};
+    use proptest::prelude::*;
+
+    const OPTIONS: [&str; 7] = [
+        "--zoom",
+        "--yaw",
+        "--pitch",
+        "--supersample",
+        "--size",
+        "--style",
+        "--at",
+    ];
+    const VALUES: [&str; 24] = [
+        "0", "-0", "nan", "NaN", "inf", "-inf", "1e300", "-1e300", "1e-300", "90", "-90", "89",
+        "0.001", "1000", "1001", "-1", "0x0", "8x8", "40x30", "8193x8", "solid", "springs", "",
+        "x",
+    ];
+
+    fn value() -> impl Strategy<Value = String> {
+        prop_oneof![
+            proptest::sample::select(VALUES.to_vec()).prop_map(str::to_string),
+            any::<f64>().prop_map(|x| x.to_string()),
+            (-5i64..5).prop_map(|k| k.to_string()),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
+
+        /// Any arguments to the picture path are refused or give a picture of the asked
+        /// size; none panics (the same check as the `args` fuzz target, on every CI run).
+        #[test]
+        fn arguments_are_refused_or_drawn_at_their_size(
+            scene in proptest::sample::select(vec!["single-spring", "chain", "jello-cube"]),
+            pairs in proptest::collection::vec((proptest::sample::select(OPTIONS.to_vec()), value()), 0..4),
+        ) {
+            let mut args = vec![scene.to_string()];
+            for (option, value) in &pairs {
+                args.push(option.to_string());
+                args.push(value.clone());
+            }
+            if !args.iter().any(|a| a == "--size") {
+                args.extend(["--size".to_string(), "40x30".to_string()]);
+            }
+            let result = std::panic::catch_unwind(|| picture_from_args(&args, 50));
+            prop_assert!(result.is_ok(), "{args:?} panicked");
+            if let Ok(Ok(image)) = result {
+                let i = args.iter().position(|a| a == "--size").unwrap();
+                let size = parse_size(&args[i + 1]).unwrap();
+                prop_assert_eq!(image.dimensions(), size, "{:?}", args);
+            }
+        }
+    }
+
+    /// The ordinary arguments draw the scene: not only background.
+    #[test]
+    fn ordinary_arguments_draw_something() {
+        let args: Vec<String> = [
+            "chain", "--size", "40x30", "--zoom", "0.8", "--pitch", "-30",
+        ]
+        .map(str::to_string)
+        .to_vec();
+        let image = picture_from_args(&args, 50).unwrap();
+        let corner = *image.get_pixel(0, 0);
+        let differing = image.pixels().filter(|p| **p != corner).count();
+        assert!(
+            differing > 20,
+            "only {differing} pixels differ from the background"
+        );
+    }
+}
