@@ -2,8 +2,8 @@
 //! through flat tables of optional keys.
 //!
 //! serde reads an internally tagged enum by buffering the whole table first, so toml can
-//! only point an error at the table's header, and the message ("expected a finite number
-//! > 0, found -1") does not say which key. Read as a flat struct instead, a bad value is
+//! only point an error at the table's header, and the message (`expected a finite number >
+//! 0, found -1`) does not say which key. Read as a flat struct instead, a bad value is
 //! reported at the value itself (the excerpt shows its key), an unknown key at the key, and
 //! a key that the kind does not take, or one it misses, by name.
 
