@@ -104,6 +104,24 @@ pub fn human(bytes: u64) -> String {
     }
 }
 
+/// Refuses to read a scene file whose parsing alone would exceed the budget.
+pub fn check_reading(path: &std::path::Path, need: u64) -> Result<()> {
+    let Some((budget, source)) = budget()? else {
+        return Ok(());
+    };
+    if need > budget {
+        let len = std::fs::metadata(path).map_or(0, |m| m.len());
+        bail!(
+            "{}: reading this {} file would need about {}, more than the {} of {source}",
+            path.display(),
+            human(len),
+            human(need),
+            human(budget)
+        );
+    }
+    Ok(())
+}
+
 /// Refuses a scene whose footprint exceeds the budget, naming what it would need and the
 /// key to change.
 pub fn check(name: &str, footprint: &Footprint) -> Result<()> {
@@ -117,7 +135,14 @@ pub fn check(name: &str, footprint: &Footprint) -> Result<()> {
     let key = footprint
         .largest
         .as_ref()
-        .map(|(k, b)| format!("; most of it is {k} ({}), make it smaller", human(*b)))
+        .map(|(k, b)| {
+            let advice = if k.ends_with(".path") {
+                "use a mesh with fewer triangles"
+            } else {
+                "make it smaller"
+            };
+            format!("; most of it is {k} ({}): {advice}", human(*b))
+        })
         .unwrap_or_default();
     bail!(
         "scene '{name}' would need about {} ({} particles, {} springs), more than the {} of \

@@ -33,6 +33,11 @@ pub fn read(arg: &str) -> Result<Source> {
         });
     }
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if let Ok(meta) = std::fs::metadata(path) {
+        let need = hooke_scene::footprint::reading_bytes(extension, meta.len());
+        crate::memory::check_reading(path, need)?;
+    }
     let spec = match path.extension().and_then(|e| e.to_str()) {
         Some("w") => hooke_scene::world::load_world(path)?.to_scene(&stem(path)),
         Some("toml") => hooke_scene::load_scene(path)?,

@@ -346,6 +346,19 @@ fn scenes_larger_than_the_memory_budget_are_refused_before_building() {
         assert!(e.contains(expect), "expected '{expect}' in: {e}");
     }
     assert!(!dir.join("t.csv").exists());
+    // A file whose parsing alone exceeds the budget is not read at all.
+    let pairs = "[[body.springs.pairs]]\ni = 0\nj = 1\nks = 1.0\nkd = 0.0\n".repeat(40_000);
+    std::fs::write(dir.join("pairs.toml"), format!("{text}{pairs}")).unwrap();
+    let out = hooke_in(&dir)
+        .args(["run", "pairs.toml", "--steps", "1"])
+        .env("HOOKE_MAX_MEMORY", "20M")
+        .output()
+        .unwrap();
+    let e = stderr(&out);
+    assert!(
+        e.contains("pairs.toml: reading this 1.") && e.contains("would need about"),
+        "{e}"
+    );
     let out = hooke_in(&dir)
         .args(["run", "jello-cube", "--steps", "10"])
         .env("HOOKE_MAX_MEMORY", "1G")

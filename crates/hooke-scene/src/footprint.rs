@@ -3,9 +3,10 @@
 //! to change, not after minutes of swapping.
 //!
 //! The costs per item are measured peaks of `hooke run SCENE --steps 1` (the build, the
-//! stability estimate and one step, integrator workspaces included) on large lattices and
-//! grids, rounded up: they over-estimate by about a fifth on those scenes, which is the
-//! side to err on.
+//! stability estimate and one step, integrator workspaces included) on lattices of 40³ and
+//! 80³ particles, grids of 500² and 1000² (with and without a contact thickness) and a
+//! 70 MB OBJ table of 2 million triangles (14 bytes per file byte), rounded up: they
+//! over-estimate those scenes by 3 to 20 %, which is the side to err on.
 
 use crate::generators::Lattice;
 use crate::spec::{ColliderShapeSpec, SceneSpec, ShapeSpec};
@@ -23,7 +24,30 @@ pub const BYTES_PER_SURFACE_PARTICLE: u64 = 500;
 pub const BYTES_PER_FIELD_NODE: u64 = 80;
 /// Bytes per byte of an OBJ table file: tobj's buffers, the triangle mesh, its BVH and the
 /// drawn copy.
-pub const BYTES_PER_MESH_FILE_BYTE: u64 = 12;
+pub const BYTES_PER_MESH_FILE_BYTE: u64 = 16;
+
+/// Peak bytes per byte of a TOML scene file while it is read (toml's spanned document and
+/// the scene built from it: 53 measured on a 21 MB file of spring pairs).
+pub const READ_BYTES_PER_TOML_BYTE: u64 = 60;
+/// Peak bytes per byte of a `.w` world while it is read (the text, the parsed vectors and
+/// the scene made from them: 4.7 measured on a 120 MB world of resolution 200).
+pub const READ_BYTES_PER_WORLD_BYTE: u64 = 6;
+
+/// The peak memory of reading a scene file of `len` bytes, by its extension (`toml` or
+/// `w`); zero for anything else.
+///
+/// ```
+/// use hooke_scene::footprint::reading_bytes;
+/// assert_eq!(reading_bytes("w", 1000), 6000);
+/// assert_eq!(reading_bytes("obj", 1000), 0);
+/// ```
+pub fn reading_bytes(extension: &str, len: u64) -> u64 {
+    match extension {
+        "toml" => len.saturating_mul(READ_BYTES_PER_TOML_BYTE),
+        "w" => len.saturating_mul(READ_BYTES_PER_WORLD_BYTE),
+        _ => 0,
+    }
+}
 
 /// A scene's estimated size and memory.
 #[derive(Clone, Debug, Default, PartialEq)]
