@@ -356,7 +356,7 @@ fn scenes_larger_than_the_memory_budget_are_refused_before_building() {
         .unwrap();
     let e = stderr(&out);
     assert!(
-        e.contains("pairs.toml: reading this 1.") && e.contains("would need about"),
+        e.contains("pairs.toml: reading this ") && e.contains("MB file would need about"),
         "{e}"
     );
     let out = hooke_in(&dir)
