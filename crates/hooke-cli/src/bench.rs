@@ -133,6 +133,14 @@ impl StepTimes {
         let mut last = started;
         let mut untimed = std::time::Duration::ZERO;
         for _ in 0..steps {
+            // An atomic load per step: far below the timer reads around it.
+            if hooke_cli::interrupt::requested() {
+                return Err(hooke_cli::interrupt::Interrupted {
+                    step: simulation.steps(),
+                    time: simulation.time(),
+                }
+                .into());
+            }
             simulation.step()?;
             let now = Instant::now();
             after(simulation);

@@ -440,5 +440,9 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
         sim_time.as_secs_f64() * 1e3 / frames.max(1) as f64,
         render_time.as_secs_f64() * 1e3 / frames.max(1) as f64,
     );
+    if interrupt::requested() {
+        eprintln!("interrupted: viewer closed");
+        return Ok(ExitCode::from(interrupt::EXIT_INTERRUPTED));
+    }
     Ok(ExitCode::SUCCESS)
 }

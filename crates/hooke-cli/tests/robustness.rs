@@ -136,8 +136,8 @@ fn two_interrupts_keep_every_complete_frame() {
     }
 }
 
-/// `render` and `demo` stop on Ctrl-C with the same status as `run`, writing no partial
-/// image and leaving no temporary file.
+/// `render`, `demo` and `bench` stop on Ctrl-C with the same status as `run`, writing no
+/// partial image and leaving no temporary file (the viewer's test covers `view`).
 #[test]
 fn render_and_demo_stop_on_interrupt_with_status_130() {
     let dir = scratch("render-int");

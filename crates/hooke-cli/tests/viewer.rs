@@ -177,5 +177,30 @@ fn viewer_animates_and_tab_switches_scenes_under_xvfb() {
         switched > 5000,
         "TAB should show another scene: {switched} pixels changed"
     );
+
+    // Ctrl-C closes the viewer with the status every interrupted command has.
+    let mut viewer = Reaper(
+        Command::new(env!("CARGO_BIN_EXE_hooke"))
+            .args(["view", "chain", "--size", "200x150"])
+            .env("DISPLAY", &display)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    );
+    until(Duration::from_secs(30), || {
+        xdotool(&display, &["search", "--name", "^hooke$"]).filter(|id| !id.is_empty())
+    })
+    .expect("a second viewer window");
+    let sent = Command::new("kill")
+        .args(["-INT", &viewer.0.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let status = until(Duration::from_secs(10), || {
+        viewer.0.try_wait().ok().flatten()
+    })
+    .expect("the viewer did not close on Ctrl-C");
+    assert_eq!(status.code(), Some(130));
     let _ = std::fs::remove_dir_all(&shots);
 }
