@@ -340,6 +340,7 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
 }
 
 pub fn convert(input: &Path, output: &Path) -> Result<ExitCode> {
+    check_output_file(output, "convert", &["toml", "w"])?;
     let ext = |p: &Path| {
         p.extension()
             .and_then(|e| e.to_str())

@@ -18,6 +18,9 @@ pub struct Source {
 /// Reads the scene named by `arg`.
 pub fn read(arg: &str) -> Result<Source> {
     let path = Path::new(arg);
+    if path.is_dir() {
+        bail!("{arg} is a folder; expected a built-in scene name, a .toml scene or a .w world");
+    }
     let is_file = path.extension().is_some_and(|e| e == "toml" || e == "w") || path.is_file();
     if !is_file {
         let spec = hooke_scene::builtin::builtin(arg).with_context(|| {
