@@ -160,7 +160,7 @@ fn the_analytic_cylinder_table_gives_the_same_drape() {
         let mut scene = builtin(
             "cloth-table",
             &Overrides {
-                table: table.map(String::from),
+                table: table.map(|t| t.parse().unwrap()),
                 duration: Some(1.5),
                 ..Overrides::default()
             },
@@ -189,7 +189,7 @@ fn cloth_table_runs_on_a_swapped_square_table() {
     let mut scene = builtin(
         "cloth-table",
         &Overrides {
-            table: Some(path.display().to_string()),
+            table: Some(hooke_scene::TableOverride::Mesh(path.display().to_string())),
             duration: Some(1.5),
             ..Overrides::default()
         },

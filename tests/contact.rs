@@ -121,7 +121,7 @@ fn crossings(frame: &Frame) -> (usize, usize) {
 /// Runs built-in `name` to its end, exporting every frame into a fresh folder.
 fn export_run(name: &str, table: Option<&str>) -> (PathBuf, u64) {
     let overrides = Overrides {
-        table: table.map(str::to_string),
+        table: table.map(|t| t.parse().unwrap()),
         ..Overrides::default()
     };
     let mut scene = builtin(name, &overrides);

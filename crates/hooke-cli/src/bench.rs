@@ -251,7 +251,7 @@ pub fn run(bench: &Bench) -> Result<ExitCode> {
             let overrides = Overrides {
                 integrator: *integrator,
                 dt: *dt,
-                table: table.clone(),
+                table: table.as_deref().map(source::table).transpose()?,
                 ..Overrides::default()
             };
             pool(*threads)?.install(|| scene_steps(scene, &overrides, *kernel, *steps, *json))

@@ -111,18 +111,11 @@ impl SetupArgs {
     /// The overrides; a table file is resolved against the current folder, as any path on
     /// the command line is (not against the scene file's folder).
     fn overrides(&self) -> anyhow::Result<Overrides> {
-        let table = match &self.table {
-            Some(t) if t == "cylinder" || t.starts_with("builtin:") => Some(t.clone()),
-            Some(t) => {
-                let path = std::path::Path::new(t);
-                if !path.is_file() {
-                    anyhow::bail!("--table {t}: no such file (expected an OBJ mesh or `cylinder`)");
-                }
-                let full = std::env::current_dir()?.join(path);
-                Some(full.to_string_lossy().into_owned())
-            }
-            None => None,
-        };
+        let table = self
+            .table
+            .as_deref()
+            .map(hooke_cli::source::table)
+            .transpose()?;
         Ok(Overrides {
             integrator: self.integrator,
             dt: self.dt,

@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result, bail};
 use hooke_scene::builtin::BUILTINS;
-use hooke_scene::{Overrides, Scene, SceneSpec};
+use hooke_scene::{BuildError, Overrides, Scene, SceneSpec, TableOverride};
 use indicatif::ProgressBar;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -57,6 +57,24 @@ fn stem(path: &Path) -> String {
         .map_or_else(|| "world".into(), |s| s.to_string_lossy().into_owned())
 }
 
+/// `--table VALUE` as the scene crate's [`TableOverride`]: `cylinder`, `builtin:NAME`, or
+/// an OBJ file relative to the current folder (made absolute here, since the scene crate
+/// resolves mesh paths against the scene file's folder).
+pub fn table(value: &str) -> Result<TableOverride> {
+    if value == "cylinder" {
+        return Ok(TableOverride::Cylinder);
+    }
+    if value.starts_with("builtin:") {
+        return Ok(TableOverride::Mesh(value.to_string()));
+    }
+    let path = Path::new(value);
+    if !path.is_file() {
+        bail!("--table {value}: no such file (expected an OBJ mesh, builtin:NAME or `cylinder`)");
+    }
+    let full = std::env::current_dir()?.join(path);
+    Ok(TableOverride::Mesh(full.to_string_lossy().into_owned()))
+}
+
 /// Builds larger than this show a spinner (on a terminal) or say that they take a while.
 const ANNOUNCE_BYTES: u64 = 256 << 20;
 
@@ -64,9 +82,22 @@ const ANNOUNCE_BYTES: u64 = 256 << 20;
 /// estimated memory exceeds the budget ([`crate::memory`]) is refused before it is built.
 pub fn build(arg: &str, overrides: &Overrides) -> Result<Scene> {
     let mut source = read(arg)?;
-    overrides
-        .apply(&mut source.spec)
-        .with_context(|| format!("scene '{arg}'"))?;
+    // The overrides come from the command line: name its options, not the scene's keys.
+    overrides.apply(&mut source.spec).map_err(|e| {
+        let e = match e {
+            BuildError::Invalid { key, message } => BuildError::Invalid {
+                key: match key.as_str() {
+                    "simulation.dt" => "--dt".into(),
+                    "simulation.duration" => "--duration".into(),
+                    "table" => "--table".into(),
+                    _ => key,
+                },
+                message,
+            },
+            other => other,
+        };
+        anyhow::Error::new(e).context(format!("scene '{arg}'"))
+    })?;
     let footprint = source.spec.footprint(&source.base);
     crate::memory::check(arg, &footprint)?;
     let large = footprint.bytes() >= ANNOUNCE_BYTES;

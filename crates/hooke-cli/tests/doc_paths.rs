@@ -1,5 +1,6 @@
 //! Every file or folder of the repository that the Markdown files, the source comments and
-//! the `--help` texts mention exists in a clone: the documentation stands on its own.
+//! the `--help` texts mention exists in a clone: the documentation stands on its own. And
+//! every Rust source says what it holds in its first line.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -183,4 +184,27 @@ fn the_path_finder_sees_what_it_should() {
         ["../shared/worlds/", "docs/physics.md", "shared/SPEC.md"]
     );
     assert_eq!(links("[a](../x.md#top) [b](https://e.org)"), ["../x.md"]);
+}
+
+/// Every Rust file in the repository opens with a `//!` comment saying what it holds
+/// (ARCHITECTURE.md's habit, checked).
+#[test]
+fn every_rust_source_opens_with_a_module_comment() {
+    let root = root();
+    let mut sources = Vec::new();
+    files(&root, "rs", &mut sources);
+    assert!(sources.len() > 50, "found only {} files", sources.len());
+    let silent: Vec<String> = sources
+        .iter()
+        .filter(|f| {
+            let text = std::fs::read_to_string(f).unwrap();
+            let first = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+            !first.starts_with("//!")
+        })
+        .map(|f| f.strip_prefix(&root).unwrap().display().to_string())
+        .collect();
+    assert!(
+        silent.is_empty(),
+        "files without an opening //! comment: {silent:?}"
+    );
 }

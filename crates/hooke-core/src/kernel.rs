@@ -46,6 +46,7 @@ impl Kernel {
         {
             if std::arch::is_x86_feature_detected!("avx512f")
                 && std::arch::is_x86_feature_detected!("avx512vl")
+                && std::arch::is_x86_feature_detected!("avx2")
             {
                 return Self::Avx512;
             }
@@ -79,10 +80,12 @@ impl Kernel {
     /// Runs the spring force loop compiled for this kernel.
     #[allow(unsafe_code)]
     pub(crate) fn scatter<const UNIFORM: bool, R: Rest>(self, args: ScatterArgs<R>) {
-        match self {
+        // Anyone can name a kernel; only one the CPU has runs (std caches the detection,
+        // so this is a few loads per call of a loop over thousands of springs).
+        match self.min(Self::detect()) {
             Self::Portable => scatter_springs::<UNIFORM, R, ComponentBatch<LANES>>(args),
-            // SAFETY: a kernel other than `Portable` comes from `detect`, which checked that
-            // the CPU has the features these functions are compiled for.
+            // SAFETY: the kernel is at most `detect()`, which checked that the CPU has every
+            // feature these functions are compiled for (and they enable nothing else).
             #[cfg(target_arch = "x86_64")]
             Self::Avx2 => unsafe { scatter_avx2::<UNIFORM, R>(args) },
             #[cfg(target_arch = "x86_64")]
@@ -117,14 +120,14 @@ impl FromStr for Kernel {
 
 /// The spring force loop compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
+#[target_feature(enable = "avx2")]
 fn scatter_avx2<const UNIFORM: bool, R: Rest>(args: ScatterArgs<R>) {
     scatter_springs::<UNIFORM, R, ComponentBatch<LANES>>(args);
 }
 
 /// The spring force loop compiled for AVX-512.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+#[target_feature(enable = "avx512f,avx512vl,avx2")]
 fn scatter_avx512<const UNIFORM: bool, R: Rest>(args: ScatterArgs<R>) {
     scatter_springs::<UNIFORM, R, VectorBatch<LANES>>(args);
 }

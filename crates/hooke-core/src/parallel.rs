@@ -155,18 +155,23 @@ pub(crate) fn axpy(y: &mut [Vec3], a: f64, x: &[Vec3]) {
     for_each(y, |i, y| *y += x[i] * a);
 }
 
+/// Most partial sums [`dot`] keeps (on the stack: a dot product allocates nothing).
+const DOT_BLOCKS: usize = 1024;
+
 /// `Σ a_i · b_i`, summed in fixed blocks whose partial sums are added in order: the same
-/// bits on any number of threads.
+/// bits on any number of threads. Blocks are [`VECTOR_BLOCK`] long up to
+/// `DOT_BLOCKS × VECTOR_BLOCK` (4 M) elements and longer beyond, both fixed by the length.
 pub(crate) fn dot(a: &[Vec3], b: &[Vec3]) -> f64 {
     let block = |(a, b): (&[Vec3], &[Vec3])| a.iter().zip(b).map(|(a, b)| a.dot(b)).sum::<f64>();
     if a.len() <= VECTOR_BLOCK {
-        block((a, b))
-    } else {
-        let partial: Vec<f64> = a
-            .par_chunks(VECTOR_BLOCK)
-            .zip(b.par_chunks(VECTOR_BLOCK))
-            .map(block)
-            .collect();
-        partial.iter().sum()
+        return block((a, b));
     }
+    let len = VECTOR_BLOCK.max(a.len().div_ceil(DOT_BLOCKS));
+    let blocks = a.len().div_ceil(len);
+    let mut partial = [0.0f64; DOT_BLOCKS];
+    partial[..blocks]
+        .par_iter_mut()
+        .zip(a.par_chunks(len).zip(b.par_chunks(len)))
+        .for_each(|(p, chunk)| *p = block(chunk));
+    partial[..blocks].iter().sum()
 }

@@ -131,7 +131,33 @@ pub struct Scene {
     pub colliders: Vec<ColliderGeometry>,
 }
 
-/// Overrides applied on top of a scene file, as from the command line.
+/// What replaces a scene's table: every mesh or cylinder collider.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TableOverride {
+    /// The analytic cylinder of the built-in round table
+    /// ([`crate::builtin::round_table_cylinder`]).
+    Cylinder,
+    /// A triangle mesh: `builtin:NAME` or an OBJ path, resolved like the scene's own mesh
+    /// paths (against the scene file's folder: callers with a path from elsewhere, such as
+    /// a command line, pass it absolute).
+    Mesh(String),
+}
+
+impl std::str::FromStr for TableOverride {
+    type Err = std::convert::Infallible;
+
+    /// `cylinder`, or anything else as a mesh path.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Ok(match s {
+            "cylinder" => Self::Cylinder,
+            path => Self::Mesh(path.to_string()),
+        })
+    }
+}
+
+/// Overrides applied on top of a scene file, as from the command line. Errors name the
+/// scene's own keys (`simulation.dt`, `table`); a caller with other names for them (the
+/// command line's `--dt`) says so itself.
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
     /// Replace the integrator.
@@ -144,9 +170,8 @@ pub struct Overrides {
     pub duration: Option<f64>,
     /// Replace the frame cadence.
     pub every: Option<u64>,
-    /// Replace the mesh of every mesh collider with this OBJ file, or with the analytic cylinder
-    /// of the built-in table when the value is `cylinder`.
-    pub table: Option<String>,
+    /// Replace every mesh or cylinder collider.
+    pub table: Option<TableOverride>,
 }
 
 impl Overrides {
@@ -157,14 +182,15 @@ impl Overrides {
             sim.integrator = IntegratorName(i);
         }
         if let Some(dt) = self.dt {
-            sim.dt = Positive::try_from(dt).map_err(|m| invalid("--dt", m))?;
+            sim.dt = Positive::try_from(dt).map_err(|m| invalid("simulation.dt", m))?;
         }
         if let Some(steps) = self.steps {
             sim.steps = Some(steps);
             sim.duration = None;
         }
         if let Some(t) = self.duration {
-            sim.duration = Some(Positive::try_from(t).map_err(|m| invalid("--duration", m))?);
+            sim.duration =
+                Some(Positive::try_from(t).map_err(|m| invalid("simulation.duration", m))?);
             sim.steps = None;
         }
         if let Some(every) = self.every {
@@ -177,31 +203,21 @@ impl Overrides {
                     c.shape,
                     ColliderShapeSpec::Mesh { .. } | ColliderShapeSpec::Cylinder { .. }
                 ) {
-                    c.shape = if table == "cylinder" {
-                        let r = hooke_collide::table::round::TOP_RADIUS;
-                        ColliderShapeSpec::Cylinder {
-                            center: [
-                                Finite(0.0),
-                                Finite(hooke_collide::table::round::TOP_Y),
-                                Finite(0.0),
-                            ],
-                            radius: Positive(r),
-                            thickness: Positive(hooke_collide::table::round::TOP_THICKNESS),
-                        }
-                    } else {
-                        ColliderShapeSpec::Mesh {
-                            path: table.clone(),
+                    c.shape = match table {
+                        TableOverride::Cylinder => crate::builtin::round_table_cylinder(),
+                        TableOverride::Mesh(path) => ColliderShapeSpec::Mesh {
+                            path: path.clone(),
                             translate: [Finite(0.0); 3],
                             rotate: [Finite(0.0); 3],
                             scale: [Positive(1.0); 3],
-                        }
+                        },
                     };
                     replaced = true;
                 }
             }
             if !replaced {
                 return Err(invalid(
-                    "--table",
+                    "table",
                     format!(
                         "scene '{}' has no table (mesh or cylinder collider) to replace",
                         spec.name

@@ -293,3 +293,14 @@ pub const BUILTINS: [(&str, Maker); 6] = [
 pub fn builtin(name: &str) -> Option<SceneSpec> {
     BUILTINS.iter().find(|(n, _)| *n == name).map(|(_, f)| f())
 }
+
+/// The analytic cylinder of the built-in round table (the course's tabletop): the shape
+/// [`crate::TableOverride::Cylinder`] puts in place of a scene's table.
+pub fn round_table_cylinder() -> ColliderShapeSpec {
+    use hooke_collide::table::round;
+    ColliderShapeSpec::Cylinder {
+        center: [Finite(0.0), Finite(round::TOP_Y), Finite(0.0)],
+        radius: Positive(round::TOP_RADIUS),
+        thickness: Positive(round::TOP_THICKNESS),
+    }
+}

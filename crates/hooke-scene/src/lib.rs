@@ -31,7 +31,7 @@ pub mod world;
 
 pub use build::{
     BUILTIN_MESHES, Body, BuildError, ColliderGeometry, MAX_PARTICLES, MAX_STEPS, Overrides, Scene,
-    Topology,
+    TableOverride, Topology,
 };
 pub use spec::SceneSpec;
 
