@@ -12,4 +12,5 @@ mod images;
 mod oscillator;
 mod roundtrip;
 mod scenes;
+mod statics;
 mod worlds;

@@ -98,12 +98,39 @@ pub fn trajectory_report(scene: &mut Scene, checkpoints: &[u64]) -> String {
     out
 }
 
-#[test]
-fn builtin_scene_trajectories() {
-    for (name, _) in BUILTINS {
-        let mut scene = builtin(name, &Overrides::default());
-        let n = scene.steps;
-        let report = trajectory_report(&mut scene, &[0, n / 4, n / 2, n]);
-        insta::assert_snapshot!(format!("scene_{name}"), report);
-    }
+/// A built-in's trajectory at its start, quarter, half and end, against its snapshot.
+fn scene_snapshot(name: &str) {
+    let mut scene = builtin(name, &Overrides::default());
+    let n = scene.steps;
+    let report = trajectory_report(&mut scene, &[0, n / 4, n / 2, n]);
+    insta::assert_snapshot!(format!("scene_{name}"), report);
+}
+
+/// One test per built-in, so that one scene's mismatch does not hide another's.
+macro_rules! scene_snapshots {
+    ($($test:ident => $name:literal),* $(,)?) => {
+        $(
+            #[test]
+            fn $test() {
+                scene_snapshot($name);
+            }
+        )*
+
+        /// Every built-in has its snapshot test above.
+        #[test]
+        fn every_builtin_has_a_snapshot_test() {
+            let tested = [$($name),*];
+            let builtins: Vec<&str> = BUILTINS.iter().map(|(n, _)| *n).collect();
+            assert_eq!(builtins, tested);
+        }
+    };
+}
+
+scene_snapshots! {
+    snapshot_single_spring => "single-spring",
+    snapshot_chain => "chain",
+    snapshot_jello_cube => "jello-cube",
+    snapshot_hanging_cloth => "hanging-cloth",
+    snapshot_cloth_table => "cloth-table",
+    snapshot_cloth_pile => "cloth-pile",
 }

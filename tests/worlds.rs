@@ -93,13 +93,37 @@ fn zero_fields_are_left_out_and_others_kept() {
     assert!(!field.is_zero());
 }
 
-#[test]
-fn public_world_trajectories() {
-    for name in WORLDS {
-        let mut scene = world(name).to_scene(name).build(Path::new(".")).unwrap();
-        let report = trajectory_report(&mut scene, &[0, 100, 500, 1000]);
-        insta::assert_snapshot!(format!("world_{name}"), report);
-    }
+/// A public world's trajectory at steps 0, 100, 500 and 1000, against its snapshot.
+fn world_snapshot(name: &str) {
+    let mut scene = world(name).to_scene(name).build(Path::new(".")).unwrap();
+    let report = trajectory_report(&mut scene, &[0, 100, 500, 1000]);
+    insta::assert_snapshot!(format!("world_{name}"), report);
+}
+
+/// One test per world, so that one world's mismatch does not hide another's.
+macro_rules! world_snapshots {
+    ($($test:ident => $name:literal),* $(,)?) => {
+        $(
+            #[test]
+            fn $test() {
+                world_snapshot($name);
+            }
+        )*
+
+        /// Every public world has its snapshot test above.
+        #[test]
+        fn every_world_has_a_snapshot_test() {
+            assert_eq!(WORLDS, [$($name),*]);
+        }
+    };
+}
+
+world_snapshots! {
+    snapshot_jello => "jello",
+    snapshot_gravity => "gravity",
+    snapshot_move_left => "moveLeft",
+    snapshot_rotate => "rotate",
+    snapshot_skewed_corner => "skewedCorner",
 }
 
 fn error(text: &str) -> String {

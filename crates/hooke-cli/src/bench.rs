@@ -3,7 +3,7 @@
 //! Figures are wall-clock times of release builds on whatever machine runs them; nothing
 //! here is asserted. `--json` prints one object per measurement for scripts.
 
-use crate::draw::{Style, draw, frame_camera};
+use crate::draw::{DEFAULT_YAW_PITCH, Style, draw, frame_camera};
 use crate::source;
 use anyhow::{Context, Result, bail};
 use hooke_core::{Integrator, Kernel, Simulation};
@@ -452,7 +452,7 @@ fn renders(
 
     for (name, scene) in &scenes {
         let list = draw(scene, Style::Solid);
-        let camera = frame_camera(scene, 30.0, 22.0);
+        let camera = frame_camera(scene, DEFAULT_YAW_PITCH.0, DEFAULT_YAW_PITCH.1);
         // As an animation renders: one renderer, its buffers reused from frame to frame.
         let mut renderer = Renderer::default();
         let mut times = Vec::new();

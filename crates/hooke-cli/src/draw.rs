@@ -286,7 +286,12 @@ pub fn draw_with(scene: &Scene, style: Style, show: impl Fn(SpringKind) -> bool)
     list
 }
 
-/// A camera that frames the bodies and colliders (not the ground) from a three-quarter view.
+/// The default view direction of every picture: yaw and pitch in degrees (the command
+/// line's `--yaw` and `--pitch` defaults, the viewer's start, the benchmarks' stills).
+pub const DEFAULT_YAW_PITCH: (f64, f64) = (30.0, 22.0);
+
+/// A camera that frames the bodies and colliders (not the ground) from `yaw`, `pitch`
+/// degrees ([`DEFAULT_YAW_PITCH`] is the three-quarter view every picture starts from).
 pub fn frame_camera(scene: &Scene, yaw: f64, pitch: f64) -> Camera {
     let x = &scene.simulation.particles().x;
     let mut lo = x.iter().fold(Vec3::repeat(f64::INFINITY), |a, p| a.inf(p));

@@ -28,6 +28,21 @@ fn progress(scene: &Scene, steps: u64) -> ProgressBar {
     bar
 }
 
+/// The whole number of the scene's steps nearest to `seconds` of simulated time (what
+/// `render --at`, the demo's stills and its animation's frame interval take), saturating
+/// for times no run reaches.
+///
+/// ```
+/// let scene = hooke_cli::source::build("chain", &Default::default()).unwrap();
+/// let dt = scene.simulation.dt();
+/// assert_eq!(hooke_cli::driver::steps_for(&scene, 10.4 * dt), 10);
+/// assert_eq!(hooke_cli::driver::steps_for(&scene, 1e300), u64::MAX);
+/// ```
+pub fn steps_for(scene: &Scene, seconds: f64) -> u64 {
+    // `as` saturates: negative and NaN give 0, beyond range u64::MAX.
+    (seconds / scene.simulation.dt()).round() as u64
+}
+
 /// Steps `n` times, one at a time so that an interrupt is answered within a step.
 fn steps(scene: &mut Scene, n: u64, bar: &ProgressBar) -> Result<()> {
     for k in 0..n {

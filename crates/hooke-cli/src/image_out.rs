@@ -1,7 +1,7 @@
 //! Rendering scenes to PNG stills and GIF animations, written atomically; a GIF is encoded
 //! frame by frame as a run produces them, so its memory does not grow with its length.
 
-use crate::draw::{Style, draw, frame_camera};
+use crate::draw::{DEFAULT_YAW_PITCH, Style, draw, frame_camera};
 use crate::output::{AtomicFile, write_atomic};
 use anyhow::{Context, Result};
 use hooke_render::{Camera, RenderOptions, render};
@@ -20,10 +20,10 @@ pub struct View {
     #[arg(long, value_enum, default_value_t = Style::Solid)]
     pub style: Style,
     /// Camera rotation about the vertical, degrees.
-    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true, value_parser = parse_angle)]
+    #[arg(long, default_value_t = DEFAULT_YAW_PITCH.0, allow_negative_numbers = true, value_parser = parse_angle)]
     pub yaw: f64,
     /// Camera elevation, degrees, from -89 to 89.
-    #[arg(long, default_value_t = 22.0, allow_negative_numbers = true, value_parser = parse_pitch)]
+    #[arg(long, default_value_t = DEFAULT_YAW_PITCH.1, allow_negative_numbers = true, value_parser = parse_pitch)]
     pub pitch: f64,
     /// Multiply the framing distance, from 0.001 to 1000 (less than 1 zooms in).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = parse_zoom)]
@@ -124,9 +124,7 @@ pub fn picture_from_args(args: &[String], max_steps: u64) -> Result<RgbaImage> {
     )?;
     let mut scene = crate::source::build(&parsed.scene, &hooke_scene::Overrides::default())?;
     let steps = match parsed.at {
-        Some(t) if t.is_finite() && t >= 0.0 => {
-            (t / scene.simulation.dt()).round().min(max_steps as f64) as u64
-        }
+        Some(t) if t.is_finite() && t >= 0.0 => crate::driver::steps_for(&scene, t).min(max_steps),
         Some(t) => anyhow::bail!(
             "--at: expected a time in seconds >= 0, found {}",
             hooke_core::Num(t)

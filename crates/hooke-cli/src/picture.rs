@@ -108,7 +108,7 @@ fn animate(
     view: &View,
 ) -> Result<PathBuf> {
     let mut scene = source::build(name, &Overrides::default())?;
-    scene.every = ((interval / scene.simulation.dt()).round() as u64).max(1);
+    scene.every = hooke_cli::driver::steps_for(&scene, interval).max(1);
     let small = View {
         size: (view.size.0 / 2, view.size.1 / 2),
         supersample: 1,

@@ -14,7 +14,7 @@ const STILL_AT: [(&str, f64); 1] = [("jello-cube", 0.45)];
 pub fn still_scene(name: &str) -> Result<Scene> {
     let mut scene = source::build(name, &Overrides::default())?;
     let steps = match STILL_AT.iter().find(|(n, _)| *n == name) {
-        Some((_, t)) => (t / scene.simulation.dt()).round() as u64,
+        Some((_, t)) => crate::driver::steps_for(&scene, *t),
         None => scene.steps,
     };
     scene.steps = steps;
@@ -41,8 +41,8 @@ impl Default for View {
         Self {
             size: (800, 600),
             style: crate::draw::Style::Solid,
-            yaw: 30.0,
-            pitch: 22.0,
+            yaw: crate::draw::DEFAULT_YAW_PITCH.0,
+            pitch: crate::draw::DEFAULT_YAW_PITCH.1,
             zoom: 1.0,
             supersample: 2,
         }

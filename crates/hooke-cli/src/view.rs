@@ -6,7 +6,7 @@
 //! real time rather than freezing the window), then the scene is drawn and the overlay
 //! written on top.
 
-use crate::draw::{Style, draw_with, frame_camera};
+use crate::draw::{DEFAULT_YAW_PITCH, Style, draw_with, frame_camera};
 use crate::image_out::write_png;
 use crate::source;
 use anyhow::{Context, Result};
@@ -78,7 +78,7 @@ struct Viewer {
 
 fn load(arg: &str) -> Result<(Scene, Camera)> {
     let scene = source::build(arg, &Overrides::default())?;
-    let camera = frame_camera(&scene, 30.0, 22.0);
+    let camera = frame_camera(&scene, DEFAULT_YAW_PITCH.0, DEFAULT_YAW_PITCH.1);
     // Room for the motion to come: cloth swings, jelly falls, chains sway.
     let camera = Camera {
         distance: camera.distance * 1.3,

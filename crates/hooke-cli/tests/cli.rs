@@ -220,32 +220,51 @@ fn divergence_names_the_step_and_particle_and_keeps_complete_frames() {
 
 #[test]
 fn the_table_can_be_swapped_from_the_command_line() {
+    use hooke_collide::table::{round, square};
     let dir = scratch("table");
-    let square = root().join("assets/meshes/square-table.obj");
-    let out = hooke(
-        &[
-            "run",
-            "cloth-table",
-            "--table",
-            square.to_str().unwrap(),
-            "--steps",
-            "100",
-        ],
-        &dir,
-    );
-    assert!(out.status.success(), "{}", stderr(&out));
-    let out = hooke(
-        &[
-            "run",
-            "cloth-table",
-            "--table",
-            "cylinder",
-            "--steps",
-            "100",
-        ],
-        &dir,
-    );
-    assert!(out.status.success(), "{}", stderr(&out));
+    let square_mesh = root().join("assets/meshes/square-table.obj");
+    // The cloth's centre particle (16, 16) of 32 × 32 ends resting on whichever top is in
+    // place, a contact thickness (5 mm) above it: the swap really changed the collider.
+    for (table, top) in [
+        (square_mesh.to_str().unwrap(), square::TOP_Y),
+        ("cylinder", round::TOP_Y),
+    ] {
+        let out = hooke(
+            &[
+                "run",
+                "cloth-table",
+                "--table",
+                table,
+                "--every",
+                "12000",
+                "--trajectory",
+                "t.csv",
+            ],
+            &dir,
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let csv = std::fs::read_to_string(dir.join("t.csv")).unwrap();
+        let centre: Vec<f64> = csv
+            .lines()
+            .filter(|l| l.starts_with("1,") && l.split(',').nth(2) == Some("528"))
+            .flat_map(|l| l.split(',').skip(3).take(3).map(|v| v.parse().unwrap()))
+            .collect();
+        assert_eq!(
+            centre.len(),
+            3,
+            "frame 1 (t = 3 s) of particle 528 in {csv:.200}"
+        );
+        let expected = top + 0.005;
+        assert!(
+            (centre[1] - expected).abs() < 1e-3,
+            "{table}: the centre rests at y = {}, expected {expected} (top + thickness)",
+            centre[1]
+        );
+        assert!(
+            centre[0].abs() < 0.05 && centre[2].abs() < 0.05,
+            "{centre:?}"
+        );
+    }
     let out = hooke(
         &["run", "chain", "--table", "cylinder", "--steps", "100"],
         &dir,

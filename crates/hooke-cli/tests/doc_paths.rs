@@ -15,10 +15,26 @@ fn root() -> PathBuf {
 
 /// Where a mentioned path starts when it names something in the repository. Anything else
 /// (`out/`, `t.csv`, `mine.toml`) is an example output or the user's own file.
-const REPO_PREFIXES: [&str; 9] = [
-    "crates/", "assets/", "tests/", "golden/", "benches/", "docs/", "fuzz/", ".ci/", "python/",
+const REPO_PREFIXES: [&str; 10] = [
+    "crates/",
+    "assets/",
+    "tests/",
+    "golden/",
+    "benches/",
+    "docs/",
+    "fuzz/",
+    ".ci/",
+    "python/",
+    "yardsticks/",
 ];
-const REPO_FILES: [&str; 4] = ["README.md", "ARCHITECTURE.md", "Cargo.toml", "Cargo.lock"];
+const REPO_FILES: [&str; 6] = [
+    "README.md",
+    "ARCHITECTURE.md",
+    "Cargo.toml",
+    "Cargo.lock",
+    "LICENSE-MIT",
+    "LICENSE-APACHE",
+];
 
 /// Tokens that look like paths: runs of path characters.
 fn path_tokens(text: &str) -> impl Iterator<Item = &str> {

@@ -472,8 +472,9 @@ impl Assembly {
         [i as usize, j as usize]
     }
 
-    /// Each spring's force derivatives at `x`, as positive semi-definite blocks (with
-    /// `u = (x_i - x_j)/l`): the elastic `Kₛ = ks (u uᵀ + max(0, 1 - L/l)(I - u uᵀ))`, so that
+    /// Each spring's force derivatives at `x`, as positive semi-definite blocks (in the
+    /// contract's names, `L = |x_i - x_j|` the length now, `l` the rest length,
+    /// `u = (x_i - x_j)/L`): the elastic `Kₛ = ks (u uᵀ + max(0, 1 - l/L)(I - u uᵀ))`, so that
     /// `∂f_i/∂x_i = -Kₛ`, and the damping `Dₛ = kd u uᵀ`, `∂f_i/∂v_i = -Dₛ`. The transverse
     /// term is clamped at zero for compressed springs (Choi & Ko 2002), which keeps the
     /// implicit system positive definite.

@@ -7,8 +7,8 @@ linear blit). Prints the median of REPEAT frames, without and with the vertex up
 pixel read-back a simulation needs each frame.
 
     pip install moderngl numpy          # Mesa's EGL and DRI drivers from the system
-    LP_NUM_THREADS=2 python3 benches/llvmpipe_cloth.py 256 9
-    LP_NUM_THREADS=2 python3 benches/llvmpipe_cloth.py 1024 5
+    LP_NUM_THREADS=2 python3 yardsticks/llvmpipe_cloth.py 256 9
+    LP_NUM_THREADS=2 python3 yardsticks/llvmpipe_cloth.py 1024 5
 """
 import os, sys, time, statistics, json
 import numpy as np

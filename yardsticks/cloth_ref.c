@@ -1,11 +1,11 @@
-/* The cloth-N workload (shared/bench/cloth-workload.md) as a plain hand-written C kernel:
+/* The cloth-N workload (docs/benchmarks.md) as a plain hand-written C kernel:
  * a spring list of index pairs, T threads, each accumulating its share of the springs into
  * a private full-size force buffer, then a parallel pass that sums the buffers and does the
  * semi-implicit Euler update. It is the kind of kernel the performance issue quotes as its
  * yardstick ("a hand-written C kernel, 2 threads, private force buffers"), written here to
  * measure this machine against the issue's: run it beside `hooke bench cloth`.
  *
- *     gcc -O3 -march=native -fopenmp -o /tmp/cloth_ref benches/cloth_ref.c -lm
+ *     gcc -O3 -march=native -fopenmp -o /tmp/cloth_ref yardsticks/cloth_ref.c -lm
  *     OMP_NUM_THREADS=2 /tmp/cloth_ref 256 400
  *
  * Prints one JSON object with the fields of `hooke bench cloth --json`. The centre y after
