@@ -23,6 +23,7 @@ pub mod builtin;
 pub mod collider_mesh;
 pub mod footprint;
 pub mod generators;
+mod overrides;
 pub mod spec;
 pub mod surface;
 mod tagged;
@@ -30,9 +31,9 @@ pub mod workload;
 pub mod world;
 
 pub use build::{
-    BUILTIN_MESHES, Body, BuildError, ColliderGeometry, MAX_PARTICLES, MAX_STEPS, Overrides, Scene,
-    TableOverride, Topology,
+    BUILTIN_MESHES, Body, BuildError, ColliderGeometry, MAX_PARTICLES, MAX_STEPS, Scene, Topology,
 };
+pub use overrides::{Overrides, TableOverride};
 pub use spec::SceneSpec;
 
 use std::path::{Path, PathBuf};
