@@ -18,7 +18,8 @@ pub struct Source {
 /// Reads the scene named by `arg`.
 pub fn read(arg: &str) -> Result<Source> {
     let path = Path::new(arg);
-    if path.is_dir() {
+    // A folder named like a built-in (`mkdir chain`) does not hide the built-in.
+    if path.is_dir() && hooke_scene::builtin::builtin(arg).is_none() {
         bail!("{arg} is a folder; expected a built-in scene name, a .toml scene or a .w world");
     }
     let is_file = path.extension().is_some_and(|e| e == "toml" || e == "w") || path.is_file();

@@ -232,7 +232,16 @@ pub(crate) const LANES: usize = 64;
 /// outer passes move data between the particles' layout and the batch's.
 #[inline(always)]
 pub(crate) fn scatter_springs<const UNIFORM: bool, R: Rest, B: SpringBatch<LANES>>(
-    ((ends, rest), (param, params), (lo, force), x, v): ScatterArgs<R>,
+    ScatterArgs {
+        ends,
+        rest,
+        param,
+        params,
+        lo,
+        force,
+        x,
+        v,
+    }: ScatterArgs<R>,
 ) {
     // Equal lengths let one bounds check on `x` cover `v` too.
     let v = &v[..x.len()];
@@ -279,15 +288,25 @@ pub(crate) fn scatter_springs<const UNIFORM: bool, R: Rest, B: SpringBatch<LANES
     force[current - lo] += pull;
 }
 
-/// The arguments of [`scatter_springs`]: the springs' ends and rest lengths, their
-/// `(ks, kd)` indices and table, the window (its first particle and forces), `x` and `v`.
-pub(crate) type ScatterArgs<'a, R> = (
-    (&'a [[u32; 2]], R),
-    (&'a [u32], &'a [[f64; 2]]),
-    (usize, &'a mut [Vec3]),
-    &'a [Vec3],
-    &'a [Vec3],
-);
+/// The arguments of [`scatter_springs`] for one partition.
+pub(crate) struct ScatterArgs<'a, R> {
+    /// The springs' ends, lower end first.
+    pub ends: &'a [[u32; 2]],
+    /// Their rest lengths.
+    pub rest: R,
+    /// Each spring's index into `params` (empty when every spring has `params[0]`).
+    pub param: &'a [u32],
+    /// The distinct `(ks, kd)` pairs.
+    pub params: &'a [[f64; 2]],
+    /// The window's first particle.
+    pub lo: usize,
+    /// The window's forces, particle `lo + k` at `k`.
+    pub force: &'a mut [Vec3],
+    /// Positions.
+    pub x: &'a [Vec3],
+    /// Velocities.
+    pub v: &'a [Vec3],
+}
 
 #[derive(Clone, Debug)]
 struct Partition {
@@ -419,28 +438,37 @@ impl Assembly {
             part.force.fill(Vec3::zeros());
             let r = part.springs.clone();
             let ends = &table.ends[r.clone()];
-            let window = (part.lo, &mut part.force[..]);
-            let params = if table.param.is_empty() {
-                None
+            let uniform = table.param.is_empty();
+            let param = if uniform {
+                &[][..]
             } else {
-                Some((&table.param[r.clone()], &table.params[..]))
+                &table.param[r.clone()]
             };
-            let uniform = (&[][..], &table.params[..]);
-            match (&table.rest, params) {
-                (RestLengths::Indexed(index, rests), None) => {
-                    let rest = (&index[r], &rests[..]);
-                    kernel.scatter::<true, _>(((ends, rest), uniform, window, x, v))
+            let (lo, force) = (part.lo, &mut part.force[..]);
+            let params = &table.params[..];
+            macro_rules! args {
+                ($rest:expr) => {
+                    ScatterArgs {
+                        ends,
+                        rest: $rest,
+                        param,
+                        params,
+                        lo,
+                        force,
+                        x,
+                        v,
+                    }
+                };
+            }
+            match (&table.rest, uniform) {
+                (RestLengths::Indexed(index, rests), true) => {
+                    kernel.scatter::<true, _>(args!((&index[r], &rests[..])))
                 }
-                (RestLengths::Indexed(index, rests), Some(params)) => {
-                    let rest = (&index[r], &rests[..]);
-                    kernel.scatter::<false, _>(((ends, rest), params, window, x, v))
+                (RestLengths::Indexed(index, rests), false) => {
+                    kernel.scatter::<false, _>(args!((&index[r], &rests[..])))
                 }
-                (RestLengths::Each(rest), None) => {
-                    kernel.scatter::<true, _>(((ends, &rest[r]), uniform, window, x, v))
-                }
-                (RestLengths::Each(rest), Some(params)) => {
-                    kernel.scatter::<false, _>(((ends, &rest[r]), params, window, x, v))
-                }
+                (RestLengths::Each(rest), true) => kernel.scatter::<true, _>(args!(&rest[r])),
+                (RestLengths::Each(rest), false) => kernel.scatter::<false, _>(args!(&rest[r])),
             }
         };
         each_partition(&mut self.partitions, scatter);
