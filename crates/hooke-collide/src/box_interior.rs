@@ -2,6 +2,18 @@
 
 use hooke_core::{Collider, Contact, Vec3};
 
+/// The six faces of an axis-aligned box as quads of corner numbers, counter-clockwise seen
+/// from outside. Corner `k` takes x from bit 2 of `k`, y from bit 1 and z from bit 0 (`0` is
+/// the low corner, `7` the high one).
+pub const BOX_FACES: [[usize; 4]; 6] = [
+    [0, 1, 3, 2],
+    [4, 6, 7, 5],
+    [0, 4, 5, 1],
+    [2, 3, 7, 6],
+    [0, 2, 6, 4],
+    [1, 5, 7, 3],
+];
+
 /// Particles must stay inside `[min, max]`; every coordinate strictly beyond a face is a
 /// violation of that face, with the excess as depth and the normal pointing into the box.
 /// A corner violates up to three faces at once and reports each (docs/physics.md §1: each violated face

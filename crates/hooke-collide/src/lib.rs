@@ -33,7 +33,7 @@ mod plane;
 pub mod table;
 mod trimesh;
 
-pub use box_interior::BoxInterior;
+pub use box_interior::{BOX_FACES, BoxInterior};
 pub use cylinder::Cylinder;
 pub use obj::{MeshError, MeshPart, Placement, load_obj, parse_obj};
 pub use plane::Plane;

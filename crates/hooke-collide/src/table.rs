@@ -100,7 +100,7 @@ impl ObjWriter {
     /// A closed axis-aligned box, faces counter-clockwise from outside.
     fn cuboid(&mut self, name: &str, lo: [f64; 3], hi: [f64; 3]) {
         self.object(name);
-        // Corner c has x from bit 2, y from bit 1, z from bit 0.
+        // Corners numbered as `BOX_FACES` expects: x from bit 2, y from bit 1, z from bit 0.
         let corner: Vec<usize> = (0..8)
             .map(|c| {
                 let pick = |bit: usize, axis: usize| {
@@ -113,14 +113,7 @@ impl ObjWriter {
                 self.vertex(pick(2, 0), pick(1, 1), pick(0, 2))
             })
             .collect();
-        for quad in [
-            [0, 1, 3, 2],
-            [4, 6, 7, 5],
-            [0, 4, 5, 1],
-            [2, 3, 7, 6],
-            [0, 2, 6, 4],
-            [1, 5, 7, 3],
-        ] {
+        for quad in crate::BOX_FACES {
             self.face(&quad.map(|c| corner[c]));
         }
     }

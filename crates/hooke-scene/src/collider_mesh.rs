@@ -102,18 +102,11 @@ impl ColliderGeometry {
             }
             Self::Box(b) => {
                 let c = |k| box_corner(b.min, b.max, k);
-                // Each wall as two triangles: x = min/max, y = min/max, z = min/max.
-                [
-                    [0, 1, 3, 2],
-                    [4, 6, 7, 5],
-                    [0, 4, 5, 1],
-                    [2, 3, 7, 6],
-                    [0, 2, 6, 4],
-                    [1, 5, 7, 3],
-                ]
-                .iter()
-                .flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]])
-                .collect()
+                // Each wall as two triangles.
+                hooke_collide::BOX_FACES
+                    .iter()
+                    .flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]])
+                    .collect()
             }
             Self::Cylinder(cyl) => cylinder_triangles(cyl),
             Self::Mesh(tris) => tris.clone(),
