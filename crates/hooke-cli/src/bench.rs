@@ -134,13 +134,7 @@ impl StepTimes {
         let mut untimed = std::time::Duration::ZERO;
         for _ in 0..steps {
             // An atomic load per step: far below the timer reads around it.
-            if hooke_cli::interrupt::requested() {
-                return Err(hooke_cli::interrupt::Interrupted {
-                    step: simulation.steps(),
-                    time: simulation.time(),
-                }
-                .into());
-            }
+            hooke_cli::interrupt::check(simulation)?;
             simulation.step()?;
             let now = Instant::now();
             after(simulation);

@@ -1,8 +1,9 @@
 //! The run loop: stepping a scene frame by frame, answering Ctrl-C within a step and
 //! showing progress on long runs.
 
-use crate::interrupt::{self, Interrupted};
-use anyhow::Result;
+use crate::interrupt;
+use anyhow::{Result, bail};
+use hooke_core::Num;
 use hooke_scene::Scene;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -43,17 +44,44 @@ pub fn steps_for(scene: &Scene, seconds: f64) -> u64 {
     (seconds / scene.simulation.dt()).round() as u64
 }
 
+/// The most steps a still at a chosen time may take: beyond this it is years of computing
+/// away.
+pub const MAX_STILL_STEPS: f64 = 1e12;
+
+/// The steps from the start to simulated time `at` seconds (`None`: the scene's end), as
+/// `render --at` takes it: refused when `at` is negative or not finite, or lies more than
+/// [`MAX_STILL_STEPS`] steps away.
+///
+/// ```
+/// let scene = hooke_cli::source::build("chain", &Default::default()).unwrap();
+/// assert_eq!(hooke_cli::driver::steps_to(&scene, None).unwrap(), scene.steps);
+/// assert!(hooke_cli::driver::steps_to(&scene, Some(1e300)).is_err());
+/// assert!(hooke_cli::driver::steps_to(&scene, Some(-1.0)).is_err());
+/// ```
+pub fn steps_to(scene: &Scene, at: Option<f64>) -> Result<u64> {
+    let Some(t) = at else {
+        return Ok(scene.steps);
+    };
+    if !(t.is_finite() && t >= 0.0) {
+        bail!("--at: expected a time in seconds >= 0, found {}", Num(t));
+    }
+    let dt = scene.simulation.dt();
+    let steps = (t / dt).round();
+    if steps > MAX_STILL_STEPS {
+        bail!(
+            "--at {} s is {steps:.1e} steps of dt = {} s, more than the {MAX_STILL_STEPS:.0e} a \
+             still may take; choose an earlier time or a larger --dt",
+            Num(t),
+            Num(dt),
+        );
+    }
+    Ok(steps as u64)
+}
+
 /// Steps `n` times, one at a time so that an interrupt is answered within a step.
 fn steps(scene: &mut Scene, n: u64, bar: &ProgressBar) -> Result<()> {
     for k in 0..n {
-        if interrupt::requested() {
-            let sim = &scene.simulation;
-            return Err(Interrupted {
-                step: sim.steps(),
-                time: sim.time(),
-            }
-            .into());
-        }
+        interrupt::check(&scene.simulation)?;
         scene.simulation.step()?;
         if k % 1024 == 1023 {
             bar.set_position(scene.simulation.steps());
@@ -64,7 +92,7 @@ fn steps(scene: &mut Scene, n: u64, bar: &ProgressBar) -> Result<()> {
 
 /// Steps `scene` to its end, calling `on_frame(frame, scene)` at frame 0 and after every
 /// `scene.every` steps. A divergence comes back as an error holding a
-/// [`hooke_core::Divergence`], an interrupt as one holding an [`Interrupted`].
+/// [`hooke_core::Divergence`], an interrupt as one holding an [`interrupt::Interrupted`].
 pub fn drive(scene: &mut Scene, mut on_frame: impl FnMut(u64, &Scene) -> Result<()>) -> Result<()> {
     let (total, every) = (scene.steps, scene.every);
     let bar = progress(scene, total);

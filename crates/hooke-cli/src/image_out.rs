@@ -114,23 +114,16 @@ struct PictureArgs {
 
 /// The argument-to-picture path of `hooke render`, in process and without files: `args`
 /// as on the command line after `render` (`chain --at 0.5 --zoom 2 --size 64x48`), the
-/// scene built, run to `--at` (at most `max_steps` steps, so that a fuzzer's `--at 1e9`
-/// stays quick) and drawn. Any argument is either refused with an error or gives a picture
-/// of the asked size; nothing panics. The fuzz target `args` and a property test drive it.
+/// scene built, run to `--at` as `render` takes it ([`crate::driver::steps_to`]; at most
+/// `max_steps` steps, so that a fuzzer's `--at 1e9` stays quick) and drawn. Any argument
+/// is either refused with an error or gives a picture of the asked size; nothing panics. The fuzz target `args` and a property test drive it.
 pub fn picture_from_args(args: &[String], max_steps: u64) -> Result<RgbaImage> {
     use clap::Parser;
     let parsed = PictureArgs::try_parse_from(
         std::iter::once("render".to_string()).chain(args.iter().cloned()),
     )?;
     let mut scene = crate::source::build(&parsed.scene, &hooke_scene::Overrides::default())?;
-    let steps = match parsed.at {
-        Some(t) if t.is_finite() && t >= 0.0 => crate::driver::steps_for(&scene, t).min(max_steps),
-        Some(t) => anyhow::bail!(
-            "--at: expected a time in seconds >= 0, found {}",
-            hooke_core::Num(t)
-        ),
-        None => max_steps.min(scene.steps),
-    };
+    let steps = crate::driver::steps_to(&scene, parsed.at)?.min(max_steps);
     crate::driver::advance(&mut scene, steps)?;
     let camera = parsed.view.camera(&scene);
     Ok(parsed.view.pixels(&scene, &camera))

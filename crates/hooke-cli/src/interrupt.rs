@@ -52,6 +52,19 @@ pub fn requested() -> bool {
     INTERRUPTS.load(Ordering::Relaxed) > 0
 }
 
+/// Between two steps of `simulation`: an [`Interrupted`] error saying where it stopped, if
+/// an interrupt arrived.
+pub fn check(simulation: &hooke_core::Simulation) -> Result<(), Interrupted> {
+    if requested() {
+        Err(Interrupted {
+            step: simulation.steps(),
+            time: simulation.time(),
+        })
+    } else {
+        Ok(())
+    }
+}
+
 /// Whether `e` (or its cause) is an interrupt.
 pub fn is_interrupt(e: &anyhow::Error) -> bool {
     e.chain().any(|c| c.downcast_ref::<Interrupted>().is_some())

@@ -191,13 +191,20 @@ pub fn check_output_file(path: &Path, flag: &str, extensions: &[&str]) -> Result
     Ok(())
 }
 
+/// Checks, before a run, that `dir` (given with option `flag`) can be an output folder: it
+/// is one, or nothing is there yet (it is created when the run starts).
+pub fn check_output_folder(dir: &Path, flag: &str) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        bail!("{flag} {}: is a file, expected a folder", dir.display());
+    }
+    Ok(())
+}
+
 /// Prepares folder `dir` (given with option `flag`) for numbered frames `frame-NNNNN.ext`:
 /// creates it if missing, refuses a file, and removes the frames an earlier run left there,
 /// so that the folder holds exactly this run's frames. Returns how many were removed.
 pub fn prepare_frame_folder(dir: &Path, flag: &str, ext: &str) -> Result<usize> {
-    if dir.exists() && !dir.is_dir() {
-        bail!("{flag} {}: is a file, expected a folder", dir.display());
-    }
+    check_output_folder(dir, flag)?;
     std::fs::create_dir_all(dir)
         .with_context(|| format!("{flag} {}: cannot create the folder", dir.display()))?;
     let mut removed = 0;

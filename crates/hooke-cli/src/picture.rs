@@ -3,9 +3,9 @@
 use crate::RenderArgs;
 use crate::image_out::{GifWriter, View, write_png};
 use crate::source;
-use anyhow::{Context, Result, bail};
-use hooke_cli::driver::{advance, drive};
-use hooke_cli::output::{check_output_file, frame_name, prepare_frame_folder};
+use anyhow::{Context, Result};
+use hooke_cli::driver::{advance, drive, steps_to};
+use hooke_cli::output::{check_output_file, check_output_folder, frame_name, prepare_frame_folder};
 use hooke_cli::stills::{still_scene, still_view};
 use hooke_core::Num;
 use hooke_scene::Overrides;
@@ -15,9 +15,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-/// The most steps `render --at` takes: beyond this a still is years of computing away.
-const MAX_RENDER_STEPS: f64 = 1e12;
-
 /// Runs from here on say how many steps they take before starting.
 const ANNOUNCE_STEPS: u64 = 1_000_000;
 
@@ -25,23 +22,7 @@ pub fn render(args: &RenderArgs) -> Result<ExitCode> {
     check_output_file(&args.output, "-o", &["png"])?;
     let mut scene = source::build(&args.scene, &args.setup.overrides()?)?;
     let dt = scene.simulation.dt();
-    let steps = match args.at {
-        Some(t) if t.is_finite() && t >= 0.0 => {
-            let steps = (t / dt).round();
-            if steps > MAX_RENDER_STEPS {
-                bail!(
-                    "--at {} s is {steps:.1e} steps of dt = {} s, more than the \
-                     {MAX_RENDER_STEPS:.0e} a still may take; choose an earlier time or a larger \
-                     --dt",
-                    Num(t),
-                    Num(dt),
-                );
-            }
-            steps as u64
-        }
-        Some(t) => bail!("--at: expected a time in seconds >= 0, found {}", Num(t)),
-        None => scene.steps,
-    };
+    let steps = steps_to(&scene, args.at)?;
     if steps >= ANNOUNCE_STEPS {
         eprintln!(
             "{}: t = {} s is {steps} steps of {} s (Ctrl-C stops)",
@@ -66,9 +47,7 @@ pub fn render(args: &RenderArgs) -> Result<ExitCode> {
 const ANIMATED: (&str, f64) = ("hanging-cloth", 0.1);
 
 pub fn demo(out: &Path, view: &View) -> Result<ExitCode> {
-    if out.exists() && !out.is_dir() {
-        bail!("--out {}: is a file, expected a folder", out.display());
-    }
+    check_output_folder(out, "--out")?;
     std::fs::create_dir_all(out)
         .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
     let mut written: Vec<PathBuf> = Vec::new();
@@ -137,8 +116,9 @@ pub struct FrameSink {
 }
 
 impl FrameSink {
-    /// Checks and prepares the outputs before a run: the frame folder is created and
-    /// cleared of an earlier run's frames, the GIF started.
+    /// Prepares the outputs before a run (whose paths `run` has checked before building the
+    /// scene): the frame folder is created and cleared of an earlier run's frames, the GIF
+    /// started.
     pub fn new(
         dir: Option<PathBuf>,
         gif: Option<PathBuf>,
@@ -160,7 +140,6 @@ impl FrameSink {
         }
         let gif = match &gif {
             Some(path) => {
-                check_output_file(path, "--gif", &["gif"])?;
                 let frame_ms = (frame_seconds * 1000.0).round().clamp(10.0, 655_350.0) as u32;
                 Some(GifWriter::create(path, view.size, frame_ms)?)
             }

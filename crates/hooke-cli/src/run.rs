@@ -6,7 +6,7 @@ use crate::{RunArgs, SetupArgs};
 use anyhow::{Context, Result, bail};
 use hooke_cli::driver::drive;
 use hooke_cli::interrupt::{self, is_interrupt};
-use hooke_cli::output::check_output_file;
+use hooke_cli::output::{check_output_file, check_output_folder};
 use hooke_core::Num;
 use hooke_core::{Divergence, Integrator, StabilityEstimate, Summary};
 use hooke_scene::{Overrides, Scene};
@@ -165,11 +165,8 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         (&args.frames, "--frames"),
         (&args.export_obj, "--export-obj"),
     ] {
-        if let Some(dir) = dir
-            && dir.exists()
-            && !dir.is_dir()
-        {
-            bail!("{flag} {}: is a file, expected a folder", dir.display());
+        if let Some(dir) = dir {
+            check_output_folder(dir, flag)?;
         }
     }
     let overrides = Overrides {
