@@ -272,7 +272,7 @@ fn a_particle_against_a_sheet_keeps_the_thickness_momentum_and_no_new_energy() {
     let under = q.v[0] * w[0] + q.v[1] * w[1] + q.v[2] * w[2];
     let closing = (q.v[3] - under).dot(&n);
     assert!(closing > -1e-12, "{closing}");
-    let stats: ContactStats = sim.workspace().contact_stats();
+    let stats: ContactStats = sim.contact_stats();
     assert!(stats.proximities >= 1);
 }
 

@@ -66,7 +66,7 @@ fn cloth_pile_self_contacts_are_bit_identical_on_one_two_and_three_threads() {
             let mut scene = builtin("cloth-pile", &Overrides::default());
             // 0.75 s: the cloth has buckled and its folds touch.
             scene.simulation.advance(3000).unwrap();
-            assert!(scene.simulation.workspace().contact_stats().proximities > 0);
+            assert!(scene.simulation.contact_stats().proximities > 0);
             state(&scene)
         })
     };
@@ -127,7 +127,7 @@ fn symplectic_reports_the_first_diverged_step_and_particle() {
     let after = scene.simulation.particles();
     let first_bad = (0..after.len()).find(|&i| !sane(&after.x[i], &after.v[i]));
     assert_eq!(first_bad, Some(err.particle));
-    assert!(scene.simulation.workspace().start_positions().is_none());
+    assert!(scene.simulation.start_positions().is_none());
     let limit = before.simulation.stability().max_dt(Integrator::Symplectic);
     let relative = (err.suggested_dt / (0.5 * limit) - 1.0).abs();
     assert!(

@@ -347,11 +347,11 @@ fn scene_steps(
     use_kernel(sim, kernel)?;
     sim.advance(steps.min(100))?;
     let mut cg_iterations = 0;
-    let contacts_before = sim.workspace().contact_stats();
+    let contacts_before = sim.contact_stats();
     let (times, seconds) = StepTimes::run(sim, steps, |sim| {
         cg_iterations += sim.workspace().cg_iterations();
     })?;
-    let contacts = sim.workspace().contact_stats();
+    let contacts = sim.contact_stats();
     let figures = SceneFigures {
         cg_iterations_per_step: cg_iterations as f64 / steps as f64,
         dt: sim.dt(),

@@ -11,10 +11,10 @@
 //! buffers add little memory beyond one force per particle, and each partition reads
 //! positions from a small, cache-resident stretch of the arrays.
 
-use crate::kernel::Kernel;
+use crate::kernel::{Kernel, ScatterArgs};
 use crate::model::Model;
 use crate::particles::Vec3;
-use crate::spring::{Spring, SpringBatch};
+use crate::spring::Spring;
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::ops::Range;
@@ -28,7 +28,8 @@ use std::ops::Range;
 /// function of the spring count alone, so the summation order never depends on the thread
 /// count.
 const PARTITION: (usize, usize) = (PARTITION_MIN, 1 << 15);
-const PARTITION_MIN: usize = 1 << 12;
+/// The fewest springs per partition; also the fewest per parallel task of per-spring work.
+pub(crate) const PARTITION_MIN: usize = 1 << 12;
 
 fn partition_size(springs: usize) -> usize {
     // From 2k to 8k springs (a small cloth, a jelly) two halves, not one partition: the
@@ -110,103 +111,6 @@ impl RestLengths {
     }
 }
 
-/// Where the force loop reads a batch's rest lengths.
-pub(crate) trait Rest: Copy + Send + Sync {
-    /// The rest length of the `l`-th spring of the slice.
-    fn rest(self, l: usize) -> f64;
-    /// Springs `range` of the slice.
-    fn slice(self, range: Range<usize>) -> Self;
-}
-
-impl Rest for &[f64] {
-    #[inline(always)]
-    fn rest(self, l: usize) -> f64 {
-        self[l]
-    }
-    #[inline(always)]
-    fn slice(self, range: Range<usize>) -> Self {
-        &self[range]
-    }
-}
-
-impl Rest for (&[u16], &[f64]) {
-    #[inline(always)]
-    fn rest(self, l: usize) -> f64 {
-        self.1[self.0[l] as usize]
-    }
-    #[inline(always)]
-    fn slice(self, range: Range<usize>) -> Self {
-        (&self.0[range], self.1)
-    }
-}
-
-/// A symmetric 3×3 matrix: `[xx, yy, zz, xy, xz, yz]`.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Sym3(pub [f64; 6]);
-
-impl Sym3 {
-    /// `u uᵀ`.
-    pub fn outer(u: &Vec3) -> Self {
-        Self([
-            u.x * u.x,
-            u.y * u.y,
-            u.z * u.z,
-            u.x * u.y,
-            u.x * u.z,
-            u.y * u.z,
-        ])
-    }
-
-    /// `s · self`.
-    pub fn scale(self, s: f64) -> Self {
-        Self(self.0.map(|v| v * s))
-    }
-
-    /// `self + s I`.
-    pub fn plus_identity(mut self, s: f64) -> Self {
-        for k in 0..3 {
-            self.0[k] += s;
-        }
-        self
-    }
-
-    /// `self + other`.
-    pub fn plus(self, other: &Sym3) -> Self {
-        Self(std::array::from_fn(|k| self.0[k] + other.0[k]))
-    }
-
-    /// `self · v`.
-    #[inline]
-    pub fn mul(&self, v: &Vec3) -> Vec3 {
-        let [xx, yy, zz, xy, xz, yz] = self.0;
-        Vec3::new(
-            xx * v.x + xy * v.y + xz * v.z,
-            xy * v.x + yy * v.y + yz * v.z,
-            xz * v.x + yz * v.y + zz * v.z,
-        )
-    }
-
-    /// The inverse, or `None` when the matrix is singular.
-    pub fn inverse(&self) -> Option<Self> {
-        let [a, d, f, b, c, e] = self.0;
-        // Cofactors of [[a b c] [b d e] [c e f]].
-        let (ca, cb, cc) = (d * f - e * e, c * e - b * f, b * e - c * d);
-        let det = a * ca + b * cb + c * cc;
-        if det.abs() <= f64::MIN_POSITIVE {
-            return None;
-        }
-        let inv = 1.0 / det;
-        Some(Self([
-            ca * inv,
-            (a * f - c * c) * inv,
-            (a * d - b * b) * inv,
-            cb * inv,
-            cc * inv,
-            (b * c - a * e) * inv,
-        ]))
-    }
-}
-
 impl SpringTable {
     #[inline]
     fn params(&self, k: usize) -> [f64; 2] {
@@ -216,96 +120,6 @@ impl SpringTable {
             self.params[self.param[k] as usize]
         }
     }
-}
-
-/// Springs per batch of the force loop.
-pub(crate) const LANES: usize = 64;
-
-/// Adds the forces of the springs `ends`/`rest` into `force`, the window of particles from
-/// `lo`. With `UNIFORM`, every spring has stiffness and damping `params[0]`; otherwise
-/// spring `k` has `params[param[k]]`.
-///
-/// Springs go in batches of [`LANES`], in three passes: load each spring's end
-/// differences into the batch, compute the batch's forces in one vectorised loop
-/// ([`SpringBatch::run`]), then add them to the ends. The middle pass is where the
-/// arithmetic is, and only there can the compiler run several springs per instruction; the
-/// outer passes move data between the particles' layout and the batch's.
-#[inline(always)]
-pub(crate) fn scatter_springs<const UNIFORM: bool, R: Rest, B: SpringBatch<LANES>>(
-    ScatterArgs {
-        ends,
-        rest,
-        param,
-        params,
-        lo,
-        force,
-        x,
-        v,
-    }: ScatterArgs<R>,
-) {
-    // Equal lengths let one bounds check on `x` cover `v` too.
-    let v = &v[..x.len()];
-    let mut batch = B::default();
-    if UNIFORM {
-        let [ks, kd] = params[0];
-        batch.set_all_params(ks, kd);
-    }
-    // Springs sharing a lower end are consecutive: sum their pull on it in a register and
-    // store once, instead of a store-to-load chain through memory per spring.
-    let mut current = lo;
-    let mut pull = Vec3::zeros();
-    let (mut lower, mut xi, mut vi) = (usize::MAX, Vec3::zeros(), Vec3::zeros());
-    for (b, ends) in ends.chunks(LANES).enumerate() {
-        // `n <= LANES` is what lets the compiler drop the batch's bounds checks.
-        let n = ends.len().min(LANES);
-        let rest = rest.slice(b * LANES..b * LANES + n);
-        for (l, &[i, j]) in ends[..n].iter().enumerate() {
-            let (i, j) = (i as usize, j as usize);
-            // Consecutive springs mostly share their lower end: load it once per run.
-            if i != lower {
-                lower = i;
-                (xi, vi) = (x[i], v[i]);
-            }
-            batch.set(l, &(xi - x[j]), &(vi - v[j]), rest.rest(l));
-            if !UNIFORM {
-                let [ks, kd] = params[param[b * LANES + l] as usize];
-                batch.set_params(l, ks, kd);
-            }
-        }
-        batch.run(n);
-        for (l, &[i, j]) in ends[..n].iter().enumerate() {
-            let (i, j) = (i as usize, j as usize);
-            let f = batch.force(l);
-            if i != current {
-                force[current - lo] += pull;
-                pull = Vec3::zeros();
-                current = i;
-            }
-            pull += f;
-            force[j - lo] -= f;
-        }
-    }
-    force[current - lo] += pull;
-}
-
-/// The arguments of [`scatter_springs`] for one partition.
-pub(crate) struct ScatterArgs<'a, R> {
-    /// The springs' ends, lower end first.
-    pub ends: &'a [[u32; 2]],
-    /// Their rest lengths.
-    pub rest: R,
-    /// Each spring's index into `params` (empty when every spring has `params[0]`).
-    pub param: &'a [u32],
-    /// The distinct `(ks, kd)` pairs.
-    pub params: &'a [[f64; 2]],
-    /// The window's first particle.
-    pub lo: usize,
-    /// The window's forces, particle `lo + k` at `k`.
-    pub force: &'a mut [Vec3],
-    /// Positions.
-    pub x: &'a [Vec3],
-    /// Velocities.
-    pub v: &'a [Vec3],
 }
 
 #[derive(Clone, Debug)]
@@ -476,7 +290,7 @@ impl Assembly {
 
     /// Scatters an antisymmetric per-spring quantity: `g(k, i, j)` is added at the spring's
     /// lower end `i` and subtracted at `j`; [`Assembly::map_gathered`] then reads the sums.
-    /// `k` indexes the assembly's own (sorted) spring order, as [`Assembly::spring_blocks`]
+    /// `k` indexes the assembly's own (sorted) spring order, as [`crate::integrator::spring_blocks`]
     /// does. This is how the implicit integrator multiplies by its system matrix.
     pub fn scatter_pairs(&mut self, g: impl Fn(usize, usize, usize) -> Vec3 + Sync) {
         let table = &self.table;
@@ -500,39 +314,19 @@ impl Assembly {
         [i as usize, j as usize]
     }
 
-    /// Each spring's force derivatives at `x`, as positive semi-definite blocks (in the
-    /// contract's names, `L = |x_i - x_j|` the length now, `l` the rest length,
-    /// `u = (x_i - x_j)/L`): the elastic `Kₛ = ks (u uᵀ + max(0, 1 - l/L)(I - u uᵀ))`, so that
-    /// `∂f_i/∂x_i = -Kₛ`, and the damping `Dₛ = kd u uᵀ`, `∂f_i/∂v_i = -Dₛ`. The transverse
-    /// term is clamped at zero for compressed springs (Choi & Ko 2002), which keeps the
-    /// implicit system positive definite.
-    pub fn spring_blocks(&self, x: &[Vec3], out: &mut Vec<[Sym3; 2]>) {
-        let table = &self.table;
-        out.resize(table.ends.len(), [Sym3::default(); 2]);
-        let block = |k: usize| {
-            let [i, j] = table.ends[k];
-            let d = x[i as usize] - x[j as usize];
-            let len = d.norm();
-            if len < crate::spring::DEGENERATE_LENGTH {
-                return [Sym3::default(); 2];
-            }
-            let u = d * (1.0 / len);
-            let [ks, kd] = table.params(k);
-            let uu = Sym3::outer(&u);
-            let transverse = (1.0 - table.rest.get(k) / len).max(0.0);
-            let elastic = uu
-                .scale(ks * (1.0 - transverse))
-                .plus_identity(ks * transverse);
-            [elastic, uu.scale(kd)]
-        };
-        if out.len() <= PARTITION.0 {
-            out.iter_mut().enumerate().for_each(|(k, o)| *o = block(k));
-        } else {
-            out.par_iter_mut()
-                .with_min_len(PARTITION.0)
-                .enumerate()
-                .for_each(|(k, o)| *o = block(k));
-        }
+    /// The number of springs.
+    pub fn springs(&self) -> usize {
+        self.table.ends.len()
+    }
+
+    /// The rest length `l` of the assembly's spring `k`.
+    pub fn rest(&self, k: usize) -> f64 {
+        self.table.rest.get(k)
+    }
+
+    /// The stiffness and damping `[ks, kd]` of the assembly's spring `k`.
+    pub fn params(&self, k: usize) -> [f64; 2] {
+        self.table.params(k)
     }
 
     /// The partitions whose window meets reduction block `b`, in order.
@@ -563,18 +357,6 @@ impl Assembly {
         }
     }
 
-    /// The total force on particle `p` at `(x, v)` given `springs`, its spring sum: external
-    /// forces, attachments and springs.
-    #[inline]
-    pub fn force(model: &Model, mass: f64, x: &Vec3, v: &Vec3, p: usize, springs: Vec3) -> Vec3 {
-        let f = model.external_force(p, mass, x, v) + springs;
-        if model.attachments.is_empty() {
-            f
-        } else {
-            f + model.attachment_force(p, x, v)
-        }
-    }
-
     /// Scatters at `(x, v)`, then sets `out[p] = map(p, F_p)` for every particle, `F_p` its
     /// total force, in parallel blocks.
     pub fn forces(
@@ -587,7 +369,7 @@ impl Assembly {
     ) {
         self.scatter(x, v);
         self.map_gathered(out, |p, springs| {
-            map(p, Self::force(model, mass[p], &x[p], &v[p], p, springs))
+            map(p, model.total_force(p, mass[p], &x[p], &v[p], springs))
         });
     }
 

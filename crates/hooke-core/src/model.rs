@@ -90,6 +90,18 @@ impl Model {
             .map_or(0.0, |s| s.thickness)
     }
 
+    /// The total force on particle `p` at `(x, v)`, given `springs`, the sum of its springs'
+    /// forces: external forces, attachments and springs.
+    #[inline]
+    pub fn total_force(&self, p: usize, mass: f64, x: &Vec3, v: &Vec3, springs: Vec3) -> Vec3 {
+        let f = self.external_force(p, mass, x, v) + springs;
+        if self.attachments.is_empty() {
+            f
+        } else {
+            f + self.attachment_force(p, x, v)
+        }
+    }
+
     /// Every force on particle `p` except its springs': gravity, field, drag, penalties (with
     /// the particle's contact thickness as the penalty springs' margin).
     #[inline]

@@ -5,6 +5,11 @@ use nalgebra::Vector3;
 /// A 3-vector of `f64`, the unit of every position, velocity and force in Hooke.
 pub type Vec3 = Vector3<f64>;
 
+/// Positions beyond this many metres from the origin count as divergence: no scene in Hooke
+/// is larger than a few metres, and an explicit blow-up passes this bound within a few steps.
+/// Scene and mesh readers refuse coordinates beyond it for the same reason.
+pub const SANE_BOUND: f64 = 1.0e6;
+
 /// The particles of a system, stored as parallel flat arrays (structure of arrays).
 ///
 /// Positions are in metres, velocities in m/s, masses in kg. A particle whose inverse mass is

@@ -1,82 +1,17 @@
 //! A running system: particles, model, integrator and step size, stepped with divergence checks.
+//!
+//! A step is the integrator's (which reports back a [`StepReport`]), then the contact phase,
+//! then the divergence check of [`crate::divergence`], which trusts the integrator's verdict
+//! unless contacts moved particles after it.
 
-use crate::integrator::{Integrator, Workspace};
+use crate::contact::{self, ContactState, ContactStats};
+use crate::divergence::{self, Divergence, StepEnd};
+use crate::integrator::{Integrator, StepReport, Workspace};
 use crate::kernel::Kernel;
 use crate::model::{Attachment, Model};
 use crate::parallel;
 use crate::particles::{Particles, Vec3};
 use crate::stability::StabilityEstimate;
-
-/// Positions beyond this many metres from the origin count as divergence: no scene in Hooke
-/// is larger than a few metres, and an explicit blow-up passes this bound within a few steps.
-pub const SANE_BOUND: f64 = 1.0e6;
-
-/// A run stopped because the state stopped making sense (docs/physics.md §7).
-///
-/// Its message names the step, the time, the particle and a step size expected to be
-/// stable, and says whether the step in use exceeds the stability estimate or not (when it
-/// does not, the step size alone does not explain the divergence).
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{}", self.message())]
-pub struct Divergence {
-    /// The step that produced the bad state (1-based: the first step is step 1).
-    pub step: u64,
-    /// Simulated time at the end of that step, in seconds.
-    pub time: f64,
-    /// The first particle found in a bad state.
-    pub particle: usize,
-    /// What was wrong with it.
-    pub what: String,
-    /// The integrator in use.
-    pub integrator: Integrator,
-    /// The step size in use.
-    pub dt: f64,
-    /// The integrator's estimated stable step at the step's start, seconds (infinite for
-    /// the implicit integrator and for systems without springs).
-    pub stable_dt: f64,
-    /// A step size expected to be stable: half the estimate, or half the step in use when
-    /// that is smaller (the estimate did not explain the divergence, so take margin).
-    pub suggested_dt: f64,
-}
-
-impl Divergence {
-    fn message(&self) -> String {
-        use crate::Num;
-        let head = format!(
-            "diverged at step {} (t = {} s): particle {} {}",
-            self.step,
-            Num(self.time),
-            self.particle,
-            self.what
-        );
-        let advice = if self.dt > self.stable_dt {
-            format!(
-                "the {} step dt = {} s exceeds its stable estimate of {:.3e} s; use dt = {:.3e} s \
-                 or smaller",
-                self.integrator,
-                Num(self.dt),
-                self.stable_dt,
-                self.suggested_dt
-            )
-        } else {
-            let estimate = if self.stable_dt.is_finite() {
-                format!("its stable estimate of {:.3e} s", self.stable_dt)
-            } else {
-                "its stable estimate (any dt)".to_string()
-            };
-            format!(
-                "the {} step dt = {} s is within {estimate}, so the step size alone does not \
-                 explain this: look for a very stiff or degenerate spring, a stiff penalty \
-                 collider, a strong force field or an extreme initial state; a smaller step, \
-                 dt = {:.3e} s, may still help",
-                self.integrator,
-                Num(self.dt),
-                self.suggested_dt
-            )
-        };
-        format!("{head}; {advice}")
-    }
-}
 
 /// A mass-spring system being simulated.
 ///
@@ -98,6 +33,10 @@ pub struct Simulation {
     dt: f64,
     step: u64,
     workspace: Workspace,
+    /// The contact phase's state, held particles included.
+    contacts: ContactState,
+    /// The last step's report (before the first step: nothing saved, nothing checked).
+    last: StepReport,
 }
 
 impl Simulation {
@@ -114,6 +53,7 @@ impl Simulation {
         }
         let mut workspace = Workspace::default();
         workspace.ensure(&model, particles.len());
+        let contacts = ContactState::new(particles.len());
         Self {
             particles,
             model,
@@ -121,6 +61,11 @@ impl Simulation {
             dt,
             step: 0,
             workspace,
+            contacts,
+            last: StepReport {
+                saved_start: false,
+                verdict: None,
+            },
         }
     }
 
@@ -156,6 +101,17 @@ impl Simulation {
         &self.workspace
     }
 
+    /// Figures of the contact phase: its wall time so far, candidate rebuilds, proximities.
+    pub fn contact_stats(&self) -> ContactStats {
+        self.contacts.stats
+    }
+
+    /// Positions at the start of the last step, if the integrator saved them (every one
+    /// does except symplectic Euler on a model without a contact phase).
+    pub fn start_positions(&self) -> Option<&[Vec3]> {
+        self.workspace.start_positions(self.last)
+    }
+
     /// The integrator in use.
     pub fn integrator(&self) -> Integrator {
         self.integrator
@@ -184,25 +140,33 @@ impl Simulation {
 
     /// [`Simulation::step`] on the current thread.
     fn step_here(&mut self) -> Result<(), Divergence> {
-        self.integrator.step(
+        let report = self.integrator.step(
             &self.model,
             &mut self.particles,
             self.dt,
             &mut self.workspace,
+            &self.contacts.held,
         );
-        let ws = &mut self.workspace;
+        self.last = report;
+        // Every scheme saves its start positions when the model has a contact phase.
         let moved = self.model.has_contact_phase()
-            && crate::contact::resolve(
+            && contact::resolve(
                 &self.model,
                 &mut self.particles,
-                &ws.x0,
-                &mut ws.stuck,
-                &mut ws.contacts,
+                &self.workspace.x0,
+                &mut self.contacts,
             );
         self.step += 1;
-        // The integrator's own check stands unless contacts moved particles after it.
-        let sane = if moved { None } else { ws.sane };
-        self.check(sane)
+        divergence::check(StepEnd {
+            model: &self.model,
+            particles: &self.particles,
+            start: self.workspace.start_positions(report),
+            // The integrator's verdict stands unless contacts moved particles after it.
+            verdict: if moved { None } else { report.verdict },
+            step: self.step,
+            integrator: self.integrator,
+            dt: self.dt,
+        })
     }
 
     /// Advances `steps` steps, stopping at the first divergence.
@@ -218,58 +182,5 @@ impl Simulation {
     /// The highest-frequency estimate of the system at its current state.
     pub fn stability(&self) -> StabilityEstimate {
         StabilityEstimate::of(&self.model, &self.particles)
-    }
-
-    /// The divergence check; `sane` is the integrator's verdict on the state, if it gave one.
-    fn check(&self, sane: Option<bool>) -> Result<(), Divergence> {
-        let p = &self.particles;
-        if sane.unwrap_or_else(|| parallel::all_sane(&p.x, &p.v, SANE_BOUND)) {
-            return Ok(());
-        }
-        let bad = parallel::find_first(p.len(), |i| {
-            let (x, v) = (&p.x[i], &p.v[i]);
-            if !(x.iter().all(|c| c.is_finite()) && v.iter().all(|c| c.is_finite())) {
-                Some((i, "is not finite".to_string()))
-            } else if x.amax() > SANE_BOUND {
-                Some((i, format!("is {:.3e} m from the origin", x.norm())))
-            } else {
-                None
-            }
-        });
-        match bad {
-            None => Ok(()),
-            Some((particle, what)) => {
-                // Estimate at the step's start: the diverged state has no meaningful geometry.
-                let mut at_start = self.particles.clone();
-                match self.workspace.start_positions() {
-                    Some(x0) => at_start.x.copy_from_slice(x0),
-                    // Symplectic Euler moved every particle by `dt v`; undone up to rounding.
-                    None => {
-                        for (x, v) in at_start.x.iter_mut().zip(&p.v) {
-                            *x -= v * self.dt;
-                        }
-                    }
-                }
-                // A state that already overflowed has no geometry to linearise at: bound the
-                // frequency from the springs' stiffness and the masses alone.
-                let finite = at_start.x.iter().all(|x| x.iter().all(|c| c.is_finite()));
-                let estimate = if finite {
-                    StabilityEstimate::of(&self.model, &at_start)
-                } else {
-                    StabilityEstimate::bound(&self.model, &at_start)
-                };
-                let stable_dt = estimate.max_dt(self.integrator);
-                Err(Divergence {
-                    step: self.step,
-                    time: self.time(),
-                    particle,
-                    what,
-                    integrator: self.integrator,
-                    dt: self.dt,
-                    stable_dt,
-                    suggested_dt: 0.5 * stable_dt.min(self.dt),
-                })
-            }
-        }
     }
 }

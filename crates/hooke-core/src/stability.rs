@@ -95,22 +95,14 @@ impl StabilityEstimate {
         }
     }
 
-    /// The largest stable step of `integrator` in seconds; infinite where the scheme has no
-    /// such limit (backward Euler, or a system without springs). Explicit Euler and midpoint
-    /// amplify every undamped oscillation slightly at any step and rely on damping; for them
-    /// 2/ω is reported as the bound beyond which damping cannot help.
+    /// The largest stable step of `integrator` in seconds: its
+    /// [`Integrator::stability_radius`] over `ω_max`; infinite where the scheme has no such
+    /// limit (backward Euler) or the system no springs.
     pub fn max_dt(&self, integrator: Integrator) -> f64 {
         if self.omega_max == 0.0 {
             return f64::INFINITY;
         }
-        let bound = match integrator {
-            // |1 + z + z²/2 + z³/6 + z⁴/24| ≤ 1 on the imaginary axis up to |z| = 2√2.
-            Integrator::Rk4 => 2.0 * std::f64::consts::SQRT_2,
-            Integrator::Euler | Integrator::Symplectic | Integrator::Midpoint => 2.0,
-            // Backward Euler is stable for every step.
-            Integrator::Implicit => return f64::INFINITY,
-        };
-        bound / self.omega_max
+        integrator.stability_radius() / self.omega_max
     }
 }
 

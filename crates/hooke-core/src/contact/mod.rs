@@ -162,6 +162,10 @@ struct FeaturePair {
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ContactState {
     ready: bool,
+    /// Per particle: whether a stick response holds it (see [`Model::resolve_contacts`]).
+    /// Sized by [`ContactState::new`], before the first step, because the implicit
+    /// integrator reads it.
+    pub(crate) held: Vec<bool>,
     /// Per particle: its surface's thickness (empty when no surface has one).
     pub(crate) margin: Vec<f64>,
     /// Per particle: its surface (among the model's), or [`NONE`].
@@ -195,6 +199,14 @@ pub(crate) struct ContactState {
 }
 
 impl ContactState {
+    /// The state for `n` particles, none held; the rest is prepared on the first step.
+    pub(crate) fn new(n: usize) -> Self {
+        Self {
+            held: vec![false; n],
+            ..Self::default()
+        }
+    }
+
     /// Reads the model's surfaces once: per-particle margins and owners, the primitives.
     fn prepare(&mut self, model: &Model, n: usize) {
         self.ready = true;
@@ -583,14 +595,14 @@ pub(crate) fn resolve(
     model: &Model,
     p: &mut Particles,
     x0: &[Vec3],
-    stuck: &mut [bool],
     state: &mut ContactState,
 ) -> bool {
     let started = Instant::now();
     if !state.ready {
         state.prepare(model, p.len());
     }
-    let moved = model.resolve_contacts(&p.inv_mass, &state.margin, x0, &mut p.x, &mut p.v, stuck);
+    let held = &mut state.held;
+    let moved = model.resolve_contacts(&p.inv_mass, &state.margin, x0, &mut p.x, &mut p.v, held);
     if state.points.is_empty() {
         state.stats.seconds += started.elapsed().as_secs_f64();
         return moved;
@@ -623,8 +635,8 @@ pub(crate) fn resolve(
         for &i in &state.moved {
             let i = i as usize;
             let (x, v) = (&mut p.x[i], &mut p.v[i]);
-            stuck[i] =
-                model.resolve_particle(p.inv_mass[i], state.margin[i], &x0[i], x, v, stuck[i]);
+            let held = &mut state.held[i];
+            *held = model.resolve_particle(p.inv_mass[i], state.margin[i], &x0[i], x, v, *held);
         }
     }
     state.moved.clear();

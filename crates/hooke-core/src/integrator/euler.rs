@@ -1,10 +1,14 @@
 //! Explicit Euler: `x' = x + dt v`, `v' = v + dt a(x, v)`, both from the old state.
 
-use super::{Workspace, accelerations, for_blocks};
+use super::{StepReport, Workspace, accelerations, for_blocks};
 use crate::model::Model;
 use crate::particles::Particles;
 
-pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) {
+/// Explicit Euler amplifies every undamped oscillation at any step and relies on damping;
+/// beyond `ω dt = 2` no damping can help, so that is the bound it reports.
+pub(super) const STABILITY_RADIUS: f64 = 2.0;
+
+pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) -> StepReport {
     ws.x0.copy_from_slice(&p.x);
     let a = &mut ws.kv[0];
     accelerations(model, &mut ws.assembly, p, &p.x, &p.v, a);
@@ -14,4 +18,5 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
             v[k] += a[start + k] * dt;
         }
     });
+    StepReport::SAVED
 }

@@ -2,7 +2,7 @@
 //! Witkin 1998), solved with preconditioned conjugate gradients.
 //!
 //! With `K` and `D` the springs' positive semi-definite stiffness and damping blocks (see
-//! [`crate::Assembly::spring_blocks`]), the velocity change solves
+//! [`blocks::spring_blocks`]), the velocity change solves
 //!
 //! `(M + dt·drag·I + dt·D + dt²·K) Δv = dt (f₀ - dt K v₀)`,
 //!
@@ -14,11 +14,14 @@
 //! tablecloth's stuck particles from being dragged through the top by long steps. The force
 //! field and penalty colliders enter through `f₀` only: their derivatives are not linearised.
 
-use super::Workspace;
-use crate::assembly::Sym3;
+use super::blocks::{self, Sym3};
+use super::{StepReport, Workspace};
 use crate::model::Model;
 use crate::parallel;
 use crate::particles::{Particles, Vec3};
+
+/// Backward Euler is stable for every step.
+pub(super) const STABILITY_RADIUS: f64 = f64::INFINITY;
 
 /// Relative residual `|r| / |b|` at which CG stops.
 pub const CG_TOLERANCE: f64 = 1e-8;
@@ -38,21 +41,26 @@ pub struct ImplicitBuffers {
     pub(crate) iterations: usize,
 }
 
-pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) {
+pub(super) fn step(
+    model: &Model,
+    p: &mut Particles,
+    dt: f64,
+    ws: &mut Workspace,
+    held: &[bool],
+) -> StepReport {
     let n = p.len();
     ws.x0.copy_from_slice(&p.x);
     let buffers = &mut ws.implicit;
     let asm = &mut ws.assembly;
-    let stuck = &ws.stuck;
     let inv_mass = &p.inv_mass;
-    let fixed = |i: usize| inv_mass[i] == 0.0 || stuck[i];
+    let fixed = |i: usize| inv_mass[i] == 0.0 || held.get(i).copied().unwrap_or(false);
 
     // Forces at the current state.
     let [f0, b, dv, r] = &mut ws.kv;
     asm.forces(model, &p.mass, (&p.x, &p.v), f0, |_, f| f);
 
     // Jacobian blocks and the system's per-spring blocks.
-    asm.spring_blocks(&p.x, &mut buffers.blocks);
+    blocks::spring_blocks(asm, &p.x, &mut buffers.blocks);
     buffers.system.clear();
     buffers.system.extend(
         buffers
@@ -96,7 +104,7 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
         };
     }
 
-    // Preconditioned CG on A Δv = b, A = M + dt·drag + Σ system blocks, pinned and stuck rows filtered.
+    // Preconditioned CG on A Δv = b, A = M + dt·drag + Σ system blocks, pinned and held rows filtered.
     let [d, q, z, _] = &mut ws.kx;
     let system = &buffers.system;
     let mass = &p.mass;
@@ -170,4 +178,5 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
             x[k] += v[k] * dt;
         }
     });
+    StepReport::SAVED
 }

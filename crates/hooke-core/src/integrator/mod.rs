@@ -4,6 +4,7 @@
 //! collision responses are not the integrator's business: [`crate::Simulation`] applies them
 //! once after the full step.
 
+mod blocks;
 mod euler;
 mod implicit;
 mod midpoint;
@@ -17,6 +18,8 @@ use crate::parallel;
 use crate::particles::{Particles, Vec3};
 use std::fmt;
 use std::str::FromStr;
+
+pub use blocks::{Sym3, spring_blocks};
 
 /// The integration scheme; maps 1:1 to the `--integrator` flag and the scene files' names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -78,19 +81,64 @@ impl Integrator {
         }
     }
 
+    /// The radius of the scheme's stability region along the imaginary axis: an undamped
+    /// oscillation of angular frequency `ω` stays bounded for `ω dt` below it. Infinite for
+    /// the implicit scheme, which is stable for every step. Each scheme's module states its
+    /// own (see [`crate::StabilityEstimate::max_dt`]).
+    pub fn stability_radius(self) -> f64 {
+        match self {
+            Self::Euler => euler::STABILITY_RADIUS,
+            Self::Symplectic => symplectic::STABILITY_RADIUS,
+            Self::Midpoint => midpoint::STABILITY_RADIUS,
+            Self::Rk4 => rk4::STABILITY_RADIUS,
+            Self::Implicit => implicit::STABILITY_RADIUS,
+        }
+    }
+
     /// Advances `particles` by `dt` seconds under `model`, without collision responses.
-    pub fn step(self, model: &Model, particles: &mut Particles, dt: f64, ws: &mut Workspace) {
+    /// `held` marks particles a stick response holds (the implicit scheme keeps them out of
+    /// its solve; the explicit ones leave that to the responses); a particle past its end
+    /// is not held, so `&[]` holds none. Returns what the step
+    /// did that its caller's checks need to know.
+    pub fn step(
+        self,
+        model: &Model,
+        particles: &mut Particles,
+        dt: f64,
+        ws: &mut Workspace,
+        held: &[bool],
+    ) -> StepReport {
         ws.ensure(model, particles.len());
-        ws.sane = None;
-        ws.start_saved = true;
         match self {
             Self::Euler => euler::step(model, particles, dt, ws),
             Self::Symplectic => symplectic::step(model, particles, dt, ws),
             Self::Midpoint => midpoint::step(model, particles, dt, ws),
             Self::Rk4 => rk4::step(model, particles, dt, ws),
-            Self::Implicit => implicit::step(model, particles, dt, ws),
+            Self::Implicit => implicit::step(model, particles, dt, ws, held),
         }
     }
+}
+
+/// What an integrator's step reports back: whether it saved the step's start positions and,
+/// for schemes that check the state in their last pass, their verdict on it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StepReport {
+    /// Whether [`Workspace::start_positions`] holds the positions at the step's start.
+    /// Symplectic Euler saves them only for models with a contact phase: the copy is a
+    /// fifth of the bytes its update pass moves.
+    pub saved_start: bool,
+    /// `Some(true)` when the scheme found every position within [`crate::SANE_BOUND`] and
+    /// every velocity finite, `Some(false)` when it did not, `None` when it did not look
+    /// (the caller then scans the state itself).
+    pub verdict: Option<bool>,
+}
+
+impl StepReport {
+    /// The report of a scheme that saved its start and left the state unchecked.
+    const SAVED: Self = Self {
+        saved_start: true,
+        verdict: None,
+    };
 }
 
 impl fmt::Display for Integrator {
@@ -120,11 +168,8 @@ impl FromStr for Integrator {
 #[derive(Clone, Debug, Default)]
 pub struct Workspace {
     pub(crate) assembly: Assembly,
-    /// Positions at the start of the current step, when `start_saved`.
+    /// Positions at the start of the last step, when its [`StepReport::saved_start`].
     pub(crate) x0: Vec<Vec3>,
-    /// Whether the step saved `x0`. Symplectic Euler does not when the model has no contact
-    /// responses to read them: the copy is a fifth of the bytes its update pass moves.
-    pub(crate) start_saved: bool,
     /// Stage derivatives: `kx` are velocities, `kv` accelerations.
     pub(crate) kx: [Vec<Vec3>; 4],
     pub(crate) kv: [Vec<Vec3>; 4],
@@ -133,26 +178,14 @@ pub struct Workspace {
     pub(crate) vt: Vec<Vec3>,
     /// The implicit integrator's blocks and preconditioner.
     pub(crate) implicit: implicit::ImplicitBuffers,
-    /// Particles held by a stick response (see [`Model::resolve_contacts`]).
-    pub(crate) stuck: Vec<bool>,
-    /// The contact phase's candidate lists and buffers.
-    pub(crate) contacts: crate::contact::ContactState,
     /// The force loop's compilation, when not the detected one.
     pub(crate) kernel: Option<Kernel>,
-    /// Whether the integrator found the state it wrote within [`crate::SANE_BOUND`], for
-    /// schemes that check it in their last pass; `None` leaves the check to the simulation.
-    pub(crate) sane: Option<bool>,
 }
 
 impl Workspace {
     /// Conjugate-gradient iterations of the last implicit step (0 for other integrators).
     pub fn cg_iterations(&self) -> usize {
         self.implicit.iterations
-    }
-
-    /// Figures of the contact phase: its wall time so far, candidate rebuilds, proximities.
-    pub fn contact_stats(&self) -> crate::contact::ContactStats {
-        self.contacts.stats
     }
 
     /// Lays out `model`'s springs and sizes the buffers for `particles` particles, unless
@@ -166,7 +199,6 @@ impl Workspace {
             self.assembly.set_kernel(kernel);
         }
         let zero = Vec3::zeros();
-        self.stuck.resize(particles, false);
         for buf in [&mut self.x0, &mut self.xt, &mut self.vt]
             .into_iter()
             .chain(self.kx.iter_mut())
@@ -181,10 +213,10 @@ impl Workspace {
         self.kernel.unwrap_or_else(Kernel::detect)
     }
 
-    /// Positions at the start of the last step, if the integrator saved them (every one
-    /// does except symplectic Euler on a model without a contact phase).
-    pub fn start_positions(&self) -> Option<&[Vec3]> {
-        self.start_saved.then_some(self.x0.as_slice())
+    /// Positions at the start of the last step, if `report` (that step's) says they were
+    /// saved.
+    pub fn start_positions(&self, report: StepReport) -> Option<&[Vec3]> {
+        report.saved_start.then_some(self.x0.as_slice())
     }
 }
 

@@ -1,10 +1,13 @@
 //! Classic fourth-order Runge–Kutta: `s' = s + dt/6 (k1 + 2 k2 + 2 k3 + k4)`.
 
-use super::{Workspace, accelerations, for_blocks, trial};
+use super::{StepReport, Workspace, accelerations, for_blocks, trial};
 use crate::model::Model;
 use crate::particles::Particles;
 
-pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) {
+/// `|1 + z + z²/2 + z³/6 + z⁴/24| ≤ 1` on the imaginary axis up to `|z| = 2√2`.
+pub(super) const STABILITY_RADIUS: f64 = 2.0 * std::f64::consts::SQRT_2;
+
+pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) -> StepReport {
     let half = 0.5 * dt;
     ws.x0.copy_from_slice(&p.x);
     // Stage 1 at the current state; its position derivative is the velocity itself.
@@ -39,4 +42,5 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
             v[k] += (k1v[i] + k2v[i] * 2.0 + k3v[i] * 2.0 + k4v[i]) * sixth;
         }
     });
+    StepReport::SAVED
 }

@@ -3,39 +3,44 @@
 //! The force gather, the update, saving the start positions and the divergence check are
 //! one pass over the particles: the method that benchmarks run streams each array once per
 //! step. The start positions are saved only for models with a contact phase, the one
-//! reader that needs them exactly (see [`Workspace::start_positions`]).
+//! reader that needs them exactly (see [`StepReport::saved_start`]).
 
-use super::Workspace;
-use crate::assembly::{Assembly, BLOCK, REDUCE_BLOCK};
+use super::{StepReport, Workspace};
+use crate::assembly::{BLOCK, REDUCE_BLOCK};
 use crate::model::Model;
 use crate::parallel;
-use crate::particles::{Particles, Vec3};
-use crate::simulation::SANE_BOUND;
+use crate::particles::{Particles, SANE_BOUND, Vec3};
 
-pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) {
+/// Symplectic Euler keeps an undamped oscillation bounded while `ω dt < 2`.
+pub(super) const STABILITY_RADIUS: f64 = 2.0;
+
+pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) -> StepReport {
     let save = model.has_contact_phase();
-    ws.start_saved = save;
-    match (model.gravity_only(), save) {
+    let sane = match (model.gravity_only(), save) {
         (true, true) => update::<true, true>(model, p, dt, ws),
         (true, false) => update::<true, false>(model, p, dt, ws),
         (false, true) => update::<false, true>(model, p, dt, ws),
         (false, false) => update::<false, false>(model, p, dt, ws),
+    };
+    StepReport {
+        saved_start: save,
+        verdict: Some(sane),
     }
 }
 
 /// The step; with `GRAVITY_ONLY` (see [`Model::gravity_only`]) the external force is
 /// `m g`, without the general per-particle tests; with `SAVE_START` the start positions
-/// go to `x0`.
+/// go to `x0`. Returns whether the state it wrote is sane.
 fn update<const GRAVITY_ONLY: bool, const SAVE_START: bool>(
     model: &Model,
     p: &mut Particles,
     dt: f64,
     ws: &mut Workspace,
-) {
+) -> bool {
     ws.assembly.scatter(&p.x, &p.v);
     let asm = &ws.assembly;
     let (mass, inv_mass) = (&p.mass, &p.inv_mass);
-    let sane = parallel::all_blocks3(BLOCK, &mut p.x, &mut p.v, &mut ws.x0, |start, x, v, x0| {
+    parallel::all_blocks3(BLOCK, &mut p.x, &mut p.v, &mut ws.x0, |start, x, v, x0| {
         let mut springs = [Vec3::zeros(); REDUCE_BLOCK];
         let mut sane = true;
         let chunks = x.chunks_mut(REDUCE_BLOCK).zip(v.chunks_mut(REDUCE_BLOCK));
@@ -55,7 +60,7 @@ fn update<const GRAVITY_ONLY: bool, const SAVE_START: bool>(
                 let f = if GRAVITY_ONLY {
                     model.gravity * mass[k] + springs[k]
                 } else {
-                    Assembly::force(model, mass[k], &x[k], &v[k], start + k, springs[k])
+                    model.total_force(start + k, mass[k], &x[k], &v[k], springs[k])
                 };
                 v[k] += f * inv_mass[k] * dt;
                 x[k] += v[k] * dt;
@@ -63,6 +68,5 @@ fn update<const GRAVITY_ONLY: bool, const SAVE_START: bool>(
             sane &= parallel::sane(x, v, SANE_BOUND);
         }
         sane
-    });
-    ws.sane = Some(sane);
+    })
 }

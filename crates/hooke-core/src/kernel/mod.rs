@@ -9,8 +9,12 @@
 //! workspace's one use of `unsafe`: calling a function compiled for features that were
 //! checked to be present.
 
-use crate::assembly::{LANES, Rest, ScatterArgs, scatter_springs};
+mod force_loop;
+
+pub(crate) use force_loop::{RestLookup, ScatterArgs};
+
 use crate::spring::{ComponentBatch, VectorBatch};
+use force_loop::{LANES, scatter_springs};
 use std::fmt;
 use std::str::FromStr;
 
@@ -79,7 +83,7 @@ impl Kernel {
 
     /// Runs the spring force loop compiled for this kernel.
     #[allow(unsafe_code)]
-    pub(crate) fn scatter<const UNIFORM: bool, R: Rest>(self, args: ScatterArgs<R>) {
+    pub(crate) fn scatter<const UNIFORM: bool, R: RestLookup>(self, args: ScatterArgs<R>) {
         // Anyone can name a kernel; only one the CPU has runs (std caches the detection,
         // so this is a few loads per call of a loop over thousands of springs).
         match self.min(Self::detect()) {
@@ -121,14 +125,14 @@ impl FromStr for Kernel {
 /// The spring force loop compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn scatter_avx2<const UNIFORM: bool, R: Rest>(args: ScatterArgs<R>) {
+fn scatter_avx2<const UNIFORM: bool, R: RestLookup>(args: ScatterArgs<R>) {
     scatter_springs::<UNIFORM, R, ComponentBatch<LANES>>(args);
 }
 
 /// The spring force loop compiled for AVX-512.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx2")]
-fn scatter_avx512<const UNIFORM: bool, R: Rest>(args: ScatterArgs<R>) {
+fn scatter_avx512<const UNIFORM: bool, R: RestLookup>(args: ScatterArgs<R>) {
     scatter_springs::<UNIFORM, R, VectorBatch<LANES>>(args);
 }
 

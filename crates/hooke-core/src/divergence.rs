@@ -1,0 +1,154 @@
+//! Divergence: finding the first particle in a bad state, and a message that says what to do.
+//!
+//! A state is sane when every velocity is finite and every position is within
+//! [`SANE_BOUND`] of the origin (docs/physics.md §7). When it is not, the run stops with a
+//! [`Divergence`] naming the step, the particle and a step size expected to be stable, from
+//! the stability estimate at the *start* of the step: the diverged state itself has no
+//! meaningful geometry.
+
+use crate::integrator::Integrator;
+use crate::model::Model;
+use crate::parallel;
+use crate::particles::{Particles, SANE_BOUND, Vec3};
+use crate::stability::StabilityEstimate;
+
+/// A run stopped because the state stopped making sense (docs/physics.md §7).
+///
+/// Its message names the step, the time, the particle and a step size expected to be
+/// stable, and says whether the step in use exceeds the stability estimate or not (when it
+/// does not, the step size alone does not explain the divergence).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{}", self.message())]
+pub struct Divergence {
+    /// The step that produced the bad state (1-based: the first step is step 1).
+    pub step: u64,
+    /// Simulated time at the end of that step, in seconds.
+    pub time: f64,
+    /// The first particle found in a bad state.
+    pub particle: usize,
+    /// What was wrong with it.
+    pub what: String,
+    /// The integrator in use.
+    pub integrator: Integrator,
+    /// The step size in use.
+    pub dt: f64,
+    /// The integrator's estimated stable step at the step's start, seconds (infinite for
+    /// the implicit integrator and for systems without springs).
+    pub stable_dt: f64,
+    /// A step size expected to be stable: half the estimate, or half the step in use when
+    /// that is smaller (the estimate did not explain the divergence, so take margin).
+    pub suggested_dt: f64,
+}
+
+/// Where a step left the state, for [`check`].
+pub(crate) struct StepEnd<'a> {
+    /// The model stepped.
+    pub model: &'a Model,
+    /// The particles as the step left them.
+    pub particles: &'a Particles,
+    /// The step's start positions, if the integrator saved them; otherwise they are
+    /// recovered by undoing `x' = x + dt v'` (symplectic Euler), up to rounding.
+    pub start: Option<&'a [Vec3]>,
+    /// The integrator's own verdict on the state, if it checked it in its last pass.
+    pub verdict: Option<bool>,
+    /// The step's number (1-based), the integrator and its step size.
+    pub step: u64,
+    pub integrator: Integrator,
+    pub dt: f64,
+}
+
+/// The divergence check after a step: `Ok` when the state is sane, otherwise the
+/// [`Divergence`] with the first bad particle and the estimate at the step's start.
+pub(crate) fn check(end: StepEnd<'_>) -> Result<(), Divergence> {
+    let p = end.particles;
+    if end
+        .verdict
+        .unwrap_or_else(|| parallel::all_sane(&p.x, &p.v, SANE_BOUND))
+    {
+        return Ok(());
+    }
+    let Some((particle, what)) = first_bad(p) else {
+        return Ok(());
+    };
+    let mut at_start = p.clone();
+    match end.start {
+        Some(x0) => at_start.x.copy_from_slice(x0),
+        None => {
+            for (x, v) in at_start.x.iter_mut().zip(&p.v) {
+                *x -= v * end.dt;
+            }
+        }
+    }
+    // A state that already overflowed has no geometry to linearise at: bound the frequency
+    // from the springs' stiffness and the masses alone.
+    let finite = at_start.x.iter().all(|x| x.iter().all(|c| c.is_finite()));
+    let estimate = if finite {
+        StabilityEstimate::of(end.model, &at_start)
+    } else {
+        StabilityEstimate::bound(end.model, &at_start)
+    };
+    let stable_dt = estimate.max_dt(end.integrator);
+    Err(Divergence {
+        step: end.step,
+        time: end.step as f64 * end.dt,
+        particle,
+        what,
+        integrator: end.integrator,
+        dt: end.dt,
+        stable_dt,
+        suggested_dt: 0.5 * stable_dt.min(end.dt),
+    })
+}
+
+/// The lowest-numbered particle in a bad state, and what is wrong with it.
+fn first_bad(p: &Particles) -> Option<(usize, String)> {
+    parallel::find_first(p.len(), |i| {
+        let (x, v) = (&p.x[i], &p.v[i]);
+        if !(x.iter().all(|c| c.is_finite()) && v.iter().all(|c| c.is_finite())) {
+            Some((i, "is not finite".to_string()))
+        } else if x.amax() > SANE_BOUND {
+            Some((i, format!("is {:.3e} m from the origin", x.norm())))
+        } else {
+            None
+        }
+    })
+}
+
+impl Divergence {
+    fn message(&self) -> String {
+        use crate::Num;
+        let head = format!(
+            "diverged at step {} (t = {} s): particle {} {}",
+            self.step,
+            Num(self.time),
+            self.particle,
+            self.what
+        );
+        let advice = if self.dt > self.stable_dt {
+            format!(
+                "the {} step dt = {} s exceeds its stable estimate of {:.3e} s; use dt = {:.3e} s \
+                 or smaller",
+                self.integrator,
+                Num(self.dt),
+                self.stable_dt,
+                self.suggested_dt
+            )
+        } else {
+            let estimate = if self.stable_dt.is_finite() {
+                format!("its stable estimate of {:.3e} s", self.stable_dt)
+            } else {
+                "its stable estimate (any dt)".to_string()
+            };
+            format!(
+                "the {} step dt = {} s is within {estimate}, so the step size alone does not \
+                 explain this: look for a very stiff or degenerate spring, a stiff penalty \
+                 collider, a strong force field or an extreme initial state; a smaller step, \
+                 dt = {:.3e} s, may still help",
+                self.integrator,
+                Num(self.dt),
+                self.suggested_dt
+            )
+        };
+        format!("{head}; {advice}")
+    }
+}
