@@ -33,7 +33,7 @@ fn root() -> std::path::PathBuf {
 /// The public `jello.w` world with another integrator.
 fn jello(integrator: Integrator) -> Scene {
     let world = hooke_scene::world::load_world(&root().join("assets/worlds/jello.w")).unwrap();
-    let mut spec = world.to_scene("jello");
+    let mut spec = world.to_scene("jello").unwrap();
     Overrides {
         integrator: Some(integrator),
         ..Overrides::default()

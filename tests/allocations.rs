@@ -79,7 +79,8 @@ fn stepping_allocates_nothing_for_any_integrator() {
         };
         let world = hooke_scene::world::load_world(&root.join("assets/worlds/jello.w"))
             .unwrap()
-            .to_scene("jello");
+            .to_scene("jello")
+            .unwrap();
         let mut world_spec = world;
         world_spec.simulation.integrator = hooke_scene::spec::IntegratorName(integrator);
         let jello = world_spec.build(&root).unwrap();

@@ -16,7 +16,7 @@ fn momentum(p: &Particles) -> Vec3 {
 fn a_free_spinning_jelly_conserves_momentum() {
     // The jello cube with gravity and the ground removed, thrown and spinning.
     let mut spec: SceneSpec = hooke_scene::builtin::builtin("jello-cube").unwrap();
-    spec.simulation.gravity = [Finite(0.0); 3];
+    spec.simulation.gravity = [Finite::of(0.0); 3];
     spec.colliders.clear();
     // A drift plus a different velocity per particle, so the springs work hard inside it.
     spec.bodies[0].velocities = Some(
@@ -24,9 +24,9 @@ fn a_free_spinning_jelly_conserves_momentum() {
             .map(|i| {
                 let t = i as f64;
                 [
-                    Finite(1.0 + (t * 0.37).sin()),
-                    Finite(2.0 + (t * 0.61).cos()),
-                    Finite(-0.5 + (t * 0.23).sin()),
+                    Finite::of(1.0 + (t * 0.37).sin()),
+                    Finite::of(2.0 + (t * 0.61).cos()),
+                    Finite::of(-0.5 + (t * 0.23).sin()),
                 ]
             })
             .collect(),

@@ -89,14 +89,14 @@ proptest! {
     ) {
         let (_, make) = hooke_scene::builtin::BUILTINS[which];
         let mut spec: SceneSpec = make();
-        spec.simulation.dt = Positive(dt);
-        spec.simulation.gravity = gravity.map(Finite);
-        spec.simulation.drag = NonNegative(drag);
+        spec.simulation.dt = Positive::of(dt);
+        spec.simulation.gravity = gravity.map(Finite::of);
+        spec.simulation.drag = NonNegative::of(drag);
         for body in &mut spec.bodies {
-            body.mass = Positive(mass);
-            body.origin = origin.map(Finite);
+            body.mass = Positive::of(mass);
+            body.origin = origin.map(Finite::of);
             if let Some(p) = &mut body.springs.structural {
-                p.ks = NonNegative(ks);
+                p.ks = NonNegative::of(ks);
             }
         }
         let text = hooke_scene::to_toml(&spec);

@@ -30,6 +30,31 @@ fn public_worlds_read_with_their_headers() {
 }
 
 #[test]
+fn a_world_built_in_code_with_bad_values_is_refused_by_name() {
+    let mut w = world("jello");
+    w.velocities[3].y = f64::NAN;
+    let e = w.to_scene("bad").unwrap_err().to_string();
+    assert_eq!(
+        e,
+        "world value velocities[3]: expected a finite number, found NaN"
+    );
+    let mut w = world("rotate");
+    w.k_elastic = -1.0;
+    w.plane = Some([1.0, f64::INFINITY, 0.0, 0.0]);
+    let e = w.to_scene("bad").unwrap_err().to_string();
+    assert!(
+        e.starts_with("world value kElastic: expected a finite number >= 0"),
+        "{e}"
+    );
+    w.k_elastic = 1.0;
+    let e = w.to_scene("bad").unwrap_err().to_string();
+    assert!(
+        e.starts_with("world value plane[1]: expected a finite number"),
+        "{e}"
+    );
+}
+
+#[test]
 fn worlds_write_and_read_back_identical() {
     for name in WORLDS {
         let w = world(name);
@@ -38,7 +63,7 @@ fn worlds_write_and_read_back_identical() {
             w,
             "{name}"
         );
-        let scene = w.to_scene(name);
+        let scene = w.to_scene(name).unwrap();
         assert_eq!(
             World::from_scene(&scene).unwrap(),
             w,
@@ -57,6 +82,7 @@ fn worlds_write_and_read_back_identical() {
 fn a_world_has_the_course_springs_and_rest_lengths() {
     let scene = world("skewedCorner")
         .to_scene("skewedCorner")
+        .unwrap()
         .build(Path::new("."))
         .unwrap();
     let springs = &scene.simulation.model().springs;
@@ -74,7 +100,13 @@ fn a_world_has_the_course_springs_and_rest_lengths() {
 /// sampling it); rotate.w's is kept.
 #[test]
 fn zero_fields_are_left_out_and_others_kept() {
-    let model_of = |name: &str| world(name).to_scene(name).build(Path::new(".")).unwrap();
+    let model_of = |name: &str| {
+        world(name)
+            .to_scene(name)
+            .unwrap()
+            .build(Path::new("."))
+            .unwrap()
+    };
     let jello = model_of("jello");
     assert!(
         world("jello")
@@ -95,7 +127,11 @@ fn zero_fields_are_left_out_and_others_kept() {
 
 /// A public world's trajectory at steps 0, 100, 500 and 1000, against its snapshot.
 fn world_snapshot(name: &str) {
-    let mut scene = world(name).to_scene(name).build(Path::new(".")).unwrap();
+    let mut scene = world(name)
+        .to_scene(name)
+        .unwrap()
+        .build(Path::new("."))
+        .unwrap();
     let report = trajectory_report(&mut scene, &[0, 100, 500, 1000]);
     insta::assert_snapshot!(format!("world_{name}"), report);
 }

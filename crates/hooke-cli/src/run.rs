@@ -350,7 +350,10 @@ pub fn convert(input: &Path, output: &Path) -> Result<ExitCode> {
             let name = input
                 .file_stem()
                 .map_or("world".into(), |s| s.to_string_lossy().into_owned());
-            hooke_scene::to_toml(&world.to_scene(&name))
+            let spec = world
+                .to_scene(&name)
+                .with_context(|| format!("{}", input.display()))?;
+            hooke_scene::to_toml(&spec)
         }
         ("toml", "w") => {
             let spec = hooke_scene::load_scene(input)?;

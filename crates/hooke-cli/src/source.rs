@@ -43,7 +43,9 @@ pub fn read(arg: &str) -> Result<Source> {
         crate::memory::check_reading(path, need)?;
     }
     let spec = match path.extension().and_then(|e| e.to_str()) {
-        Some("w") => hooke_scene::world::load_world(path)?.to_scene(&stem(path)),
+        Some("w") => hooke_scene::world::load_world(path)?
+            .to_scene(&stem(path))
+            .with_context(|| format!("{}", path.display()))?,
         Some("toml") => hooke_scene::load_scene(path)?,
         _ => bail!(
             "{}: expected a scene file ending in .toml or a jello world ending in .w",

@@ -268,8 +268,5 @@ const EXCERPT_CHARS: usize = 80;
 
 /// At most [`EXCERPT_CHARS`] characters of `text`, with `…` where it was cut.
 fn excerpt(text: &str) -> String {
-    match text.char_indices().nth(EXCERPT_CHARS) {
-        Some((cut, _)) => format!("{}…", &text[..cut]),
-        None => text.to_string(),
-    }
+    hooke_core::excerpt(text, EXCERPT_CHARS)
 }

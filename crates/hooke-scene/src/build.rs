@@ -132,7 +132,7 @@ pub struct Scene {
 }
 
 fn vec3(v: &[Finite; 3]) -> Vec3 {
-    Vec3::new(v[0].0, v[1].0, v[2].0)
+    Vec3::new(v[0].get(), v[1].get(), v[2].get())
 }
 
 fn rotation(degrees: &[Finite; 3]) -> Rotation3<f64> {
@@ -160,14 +160,14 @@ impl SceneSpec {
             )),
             (Some(n), None) => Ok(n),
             (None, Some(t)) => {
-                let n = (t.0 / sim.dt.0).round();
+                let n = (t.get() / sim.dt.get()).round();
                 if !(1.0..=MAX_STEPS as f64).contains(&n) {
                     Err(invalid(
                         "simulation.duration",
                         format!(
                             "{} s at dt = {} s is {}; expected 1 to {MAX_STEPS} steps",
-                            Num(t.0),
-                            Num(sim.dt.0),
+                            Num(t.get()),
+                            Num(sim.dt.get()),
                             if n < 1.0 {
                                 "less than one step".to_string()
                             } else {
@@ -273,7 +273,7 @@ impl SceneSpec {
                         ),
                     ));
                 }
-                particles.push(x, v, body.mass.0);
+                particles.push(x, v, body.mass.get());
             }
             for (k, &pin) in body.pins.iter().enumerate() {
                 if pin >= n {
@@ -315,10 +315,13 @@ impl SceneSpec {
             let solid = matches!(spec.response, ResponseSpec::Penalty { .. });
             let (shape, geo) = build_collider(&spec.shape, &key, base, &centroid, solid)?;
             let response = match spec.response {
-                ResponseSpec::Penalty { kc, dc } => Response::Penalty { kc: kc.0, dc: dc.0 },
+                ResponseSpec::Penalty { kc, dc } => Response::Penalty {
+                    kc: kc.get(),
+                    dc: dc.get(),
+                },
                 ResponseSpec::Restitution { cr, friction } => Response::Restitution {
-                    cr: cr.0,
-                    friction: friction.0,
+                    cr: cr.get(),
+                    friction: friction.get(),
                 },
                 ResponseSpec::Stick => Response::Stick,
             };
@@ -349,7 +352,7 @@ impl SceneSpec {
         let model = Model {
             springs,
             gravity: vec3(&self.simulation.gravity),
-            drag: self.simulation.drag.0,
+            drag: self.simulation.drag.get(),
             field,
             colliders: slots,
             attachments: Vec::new(),
@@ -359,7 +362,7 @@ impl SceneSpec {
             particles,
             model,
             self.simulation.integrator.0,
-            self.simulation.dt.0,
+            self.simulation.dt.get(),
         );
         Ok(Scene {
             spec: self.clone(),
@@ -383,10 +386,10 @@ fn body_surface(
 ) -> Result<Surface, BuildError> {
     let default = match body.shape {
         // A quarter of the spacing at most, so a fine cloth's neighbours never touch.
-        ShapeSpec::Grid { spacing, .. } => DEFAULT_CLOTH_THICKNESS.min(0.25 * spacing.0),
+        ShapeSpec::Grid { spacing, .. } => DEFAULT_CLOTH_THICKNESS.min(0.25 * spacing.get()),
         _ => 0.0,
     };
-    let thickness = body.thickness.map_or(default, |h| h.0);
+    let thickness = body.thickness.map_or(default, |h| h.get());
     if thickness > 0.0 && triangles.is_empty() {
         return Err(invalid(
             format!("{key}.thickness"),
@@ -399,7 +402,7 @@ fn body_surface(
         triangles,
         thickness,
         self_collision,
-        friction: body.friction.map_or(DEFAULT_SURFACE_FRICTION, |f| f.0),
+        friction: body.friction.map_or(DEFAULT_SURFACE_FRICTION, |f| f.get()),
     };
     if thickness > 0.0 && self_collision && !surface.triangles.is_empty() {
         // Measured on the rest shape, which is what the springs keep.
@@ -436,19 +439,21 @@ fn build_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, Bu
             Lattice {
                 size: [*count, 1, 1],
             },
-            spacing.0,
+            spacing.get(),
             Topology::Chain,
         ),
         ShapeSpec::Grid { size, spacing } => (
             Lattice {
                 size: [size[0], 1, size[1]],
             },
-            spacing.0,
+            spacing.get(),
             Topology::Grid(*size),
         ),
-        ShapeSpec::Lattice { size, spacing } => {
-            (Lattice { size: *size }, spacing.0, Topology::Lattice(*size))
-        }
+        ShapeSpec::Lattice { size, spacing } => (
+            Lattice { size: *size },
+            spacing.get(),
+            Topology::Lattice(*size),
+        ),
         ShapeSpec::Points { positions } => {
             let local: Vec<Vec3> = positions.iter().map(vec3).collect();
             if body.springs.structural.is_some()
@@ -493,8 +498,8 @@ fn build_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, Bu
                 i: (offset + e.i as usize) as u32,
                 j: (offset + e.j as usize) as u32,
                 rest: e.rest,
-                ks: p.ks.0,
-                kd: p.kd.0,
+                ks: p.ks.get(),
+                kd: p.kd.get(),
                 kind,
             }));
         }
@@ -530,13 +535,13 @@ fn pairs(
             }
             let rest = p
                 .rest
-                .map_or_else(|| (local[p.i] - local[p.j]).norm(), |r| r.0);
+                .map_or_else(|| (local[p.i] - local[p.j]).norm(), |r| r.get());
             Ok(Spring {
                 i: (offset + p.i) as u32,
                 j: (offset + p.j) as u32,
                 rest,
-                ks: p.ks.0,
-                kd: p.kd.0,
+                ks: p.ks.get(),
+                kd: p.kd.get(),
                 kind: SpringKind::Other,
             })
         })
@@ -588,11 +593,11 @@ fn build_collider(
 ) -> Result<(Box<dyn Collider>, ColliderGeometry), BuildError> {
     Ok(match shape {
         ColliderShapeSpec::Ground { height } => (
-            Box::new(Plane::ground(height.0)),
-            ColliderGeometry::Ground(height.0),
+            Box::new(Plane::ground(height.get())),
+            ColliderGeometry::Ground(height.get()),
         ),
         ColliderShapeSpec::Plane { coefficients } => {
-            let c = coefficients.map(|x| x.0);
+            let c = coefficients.map(|x| x.get());
             let plane = Plane::inclined(c, centroid).ok_or_else(|| {
                 invalid(
                     format!("{key}.shape.coefficients"),
@@ -621,8 +626,8 @@ fn build_collider(
         } => {
             let c = Cylinder {
                 center: vec3(center),
-                radius: radius.0,
-                thickness: thickness.0,
+                radius: radius.get(),
+                thickness: thickness.get(),
             };
             (Box::new(c), ColliderGeometry::Cylinder(c))
         }
@@ -635,7 +640,7 @@ fn build_collider(
             let placement = Placement {
                 translate: vec3(translate),
                 rotate: vec3(rotate),
-                scale: Vec3::new(scale[0].0, scale[1].0, scale[2].0),
+                scale: Vec3::new(scale[0].get(), scale[1].get(), scale[2].get()),
             };
             let mesh = || -> Result<TriMeshCollider, MeshError> {
                 let (text, full) = mesh_text(path, base)?;

@@ -9,25 +9,25 @@ use crate::spec::*;
 use hooke_core::Integrator;
 
 fn f3(v: [f64; 3]) -> [Finite; 3] {
-    v.map(Finite)
+    v.map(Finite::of)
 }
 
 fn params(ks: f64, kd: f64) -> Option<SpringParams> {
     Some(SpringParams {
-        ks: NonNegative(ks),
-        kd: NonNegative(kd),
+        ks: NonNegative::of(ks),
+        kd: NonNegative::of(kd),
     })
 }
 
 fn sim(integrator: Integrator, dt: f64, duration: f64, every: u64, drag: f64) -> SimulationSpec {
     SimulationSpec {
         integrator: IntegratorName(integrator),
-        dt: Positive(dt),
-        duration: Some(Positive(duration)),
+        dt: Positive::of(dt),
+        duration: Some(Positive::of(duration)),
         steps: None,
         every,
         gravity: f3([0.0, -9.81, 0.0]),
-        drag: NonNegative(drag),
+        drag: NonNegative::of(drag),
     }
 }
 
@@ -40,7 +40,7 @@ fn body(
 ) -> BodySpec {
     BodySpec {
         name: name.into(),
-        mass: Positive(mass),
+        mass: Positive::of(mass),
         origin: f3(origin),
         rotate: f3([0.0; 3]),
         velocity: f3([0.0; 3]),
@@ -58,11 +58,11 @@ fn body(
 fn ground(cr: f64, friction: f64) -> ColliderSpec {
     ColliderSpec {
         shape: ColliderShapeSpec::Ground {
-            height: Finite(0.0),
+            height: Finite::of(0.0),
         },
         response: ResponseSpec::Restitution {
-            cr: Fraction(cr),
-            friction: Fraction(friction),
+            cr: Fraction::of(cr),
+            friction: Fraction::of(friction),
         },
     }
 }
@@ -89,9 +89,9 @@ pub fn single_spring() -> SceneSpec {
     b.springs.pairs = vec![PairSpec {
         i: 0,
         j: 1,
-        ks: NonNegative(SINGLE_SPRING_KS),
-        kd: NonNegative(SINGLE_SPRING_KD),
-        rest: Some(NonNegative(1.0)),
+        ks: NonNegative::of(SINGLE_SPRING_KS),
+        kd: NonNegative::of(SINGLE_SPRING_KD),
+        rest: Some(NonNegative::of(1.0)),
     }];
     SceneSpec {
         name: "single-spring".into(),
@@ -119,7 +119,7 @@ pub fn chain() -> SceneSpec {
         [0.0, 2.2, 0.0],
         ShapeSpec::Chain {
             count: CHAIN_COUNT,
-            spacing: Positive(0.15),
+            spacing: Positive::of(0.15),
         },
         SpringsSpec {
             structural: params(CHAIN_KS, 0.2),
@@ -148,7 +148,7 @@ pub fn jello_cube() -> SceneSpec {
         [-0.15, 0.9, -0.25],
         ShapeSpec::Lattice {
             size: [8, 8, 8],
-            spacing: Positive(0.5 / 7.0),
+            spacing: Positive::of(0.5 / 7.0),
         },
         SpringsSpec {
             structural: params(300.0, 0.3),
@@ -180,7 +180,7 @@ pub fn hanging_cloth() -> SceneSpec {
         [-0.5, 2.0, -0.5],
         ShapeSpec::Grid {
             size: [n, n],
-            spacing: Positive(1.0 / (n - 1) as f64),
+            spacing: Positive::of(1.0 / (n - 1) as f64),
         },
         SpringsSpec {
             structural: params(400.0, 0.02),
@@ -212,7 +212,7 @@ fn square_cloth(n: usize, side: f64, kg: f64, origin: [f64; 3], bend: (f64, f64)
         origin,
         ShapeSpec::Grid {
             size: [n, n],
-            spacing: Positive(side / (n - 1) as f64),
+            spacing: Positive::of(side / (n - 1) as f64),
         },
         SpringsSpec {
             structural: params(300.0, 0.02),
@@ -248,7 +248,7 @@ pub fn cloth_table() -> SceneSpec {
                     path: "builtin:table.obj".into(),
                     translate: f3([0.0; 3]),
                     rotate: f3([0.0; 3]),
-                    scale: [Positive(1.0); 3],
+                    scale: [Positive::of(1.0); 3],
                 },
                 response: ResponseSpec::Stick,
             },
@@ -299,8 +299,8 @@ pub fn builtin(name: &str) -> Option<SceneSpec> {
 pub fn round_table_cylinder() -> ColliderShapeSpec {
     use hooke_collide::table::round;
     ColliderShapeSpec::Cylinder {
-        center: [Finite(0.0), Finite(round::TOP_Y), Finite(0.0)],
-        radius: Positive(round::TOP_RADIUS),
-        thickness: Positive(round::TOP_THICKNESS),
+        center: [Finite::of(0.0), Finite::of(round::TOP_Y), Finite::of(0.0)],
+        radius: Positive::of(round::TOP_RADIUS),
+        thickness: Positive::of(round::TOP_THICKNESS),
     }
 }

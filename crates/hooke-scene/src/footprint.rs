@@ -142,7 +142,7 @@ impl SceneSpec {
             }
             // A grid has a surface with a thickness unless it is set to zero.
             let surface = matches!(body.shape, ShapeSpec::Grid { .. })
-                && body.thickness.is_none_or(|t| t.0 > 0.0);
+                && body.thickness.is_none_or(|t| t.get() > 0.0);
             let surface_particles = if surface { particles } else { 0 };
             f.particles = f.particles.saturating_add(particles);
             f.springs = f.springs.saturating_add(springs);

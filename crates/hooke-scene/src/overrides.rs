@@ -82,9 +82,9 @@ impl Overrides {
                         TableOverride::Cylinder => crate::builtin::round_table_cylinder(),
                         TableOverride::Mesh(path) => ColliderShapeSpec::Mesh {
                             path: path.clone(),
-                            translate: [Finite(0.0); 3],
-                            rotate: [Finite(0.0); 3],
-                            scale: [Positive(1.0); 3],
+                            translate: [Finite::of(0.0); 3],
+                            rotate: [Finite::of(0.0); 3],
+                            scale: [Positive::of(1.0); 3],
                         },
                     };
                     replaced = true;

@@ -8,105 +8,90 @@
 use hooke_core::{Integrator, SpringKind};
 use serde::{Deserialize, Serialize};
 
-/// A finite `f64`, refused at read time when NaN or infinite.
-#[derive(Clone, Copy, Debug, PartialEq, PartialOrd, Serialize, Deserialize)]
-#[serde(try_from = "f64", into = "f64")]
-pub struct Finite(pub f64);
+/// Defines a checked `f64`: a private field, so a value exists only once it passed `$ok`.
+macro_rules! checked_number {
+    ($(#[$doc:meta])* $name:ident, $expected:literal, |$x:ident| $ok:expr) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy, Debug, PartialEq, PartialOrd, Serialize, Deserialize)]
+        #[serde(try_from = "f64", into = "f64")]
+        pub struct $name(f64);
 
-impl TryFrom<f64> for Finite {
-    type Error = String;
-    fn try_from(x: f64) -> Result<Self, String> {
-        if x.is_finite() {
-            Ok(Self(x))
-        } else {
-            Err(format!(
-                "expected a finite number, found {}",
-                hooke_core::Num(x)
-            ))
+        // `Range::contains` is not a `const fn`; `of` is.
+        #[allow(clippy::manual_range_contains)]
+        impl $name {
+            #[doc = concat!("`x` when it is ", $expected, "; otherwise what was expected and found.")]
+            pub fn new($x: f64) -> Result<Self, String> {
+                if $ok {
+                    Ok(Self($x))
+                } else {
+                    Err(format!(
+                        concat!("expected ", $expected, ", found {}"),
+                        hooke_core::Num($x)
+                    ))
+                }
+            }
+
+            #[doc = concat!("`x`, which must be ", $expected, ": for constants and values")]
+            /// already checked; use `new` for anything read or computed.
+            ///
+            /// # Panics
+            /// When `x` is out of range (at compile time in a `const`).
+            pub const fn of($x: f64) -> Self {
+                assert!($ok, concat!("expected ", $expected));
+                Self($x)
+            }
+
+            /// The value.
+            pub const fn get(self) -> f64 {
+                self.0
+            }
         }
-    }
-}
 
-impl From<Finite> for f64 {
-    fn from(x: Finite) -> f64 {
-        x.0
-    }
-}
-
-/// A finite `f64` greater than zero.
-#[derive(Clone, Copy, Debug, PartialEq, PartialOrd, Serialize, Deserialize)]
-#[serde(try_from = "f64", into = "f64")]
-pub struct Positive(pub f64);
-
-impl TryFrom<f64> for Positive {
-    type Error = String;
-    fn try_from(x: f64) -> Result<Self, String> {
-        if x.is_finite() && x > 0.0 {
-            Ok(Self(x))
-        } else {
-            Err(format!(
-                "expected a finite number > 0, found {}",
-                hooke_core::Num(x)
-            ))
+        impl TryFrom<f64> for $name {
+            type Error = String;
+            fn try_from(x: f64) -> Result<Self, String> {
+                Self::new(x)
+            }
         }
-    }
-}
 
-impl From<Positive> for f64 {
-    fn from(x: Positive) -> f64 {
-        x.0
-    }
-}
-
-/// A finite `f64` at least zero.
-#[derive(Clone, Copy, Debug, PartialEq, PartialOrd, Serialize, Deserialize)]
-#[serde(try_from = "f64", into = "f64")]
-pub struct NonNegative(pub f64);
-
-impl TryFrom<f64> for NonNegative {
-    type Error = String;
-    fn try_from(x: f64) -> Result<Self, String> {
-        if x.is_finite() && x >= 0.0 {
-            Ok(Self(x))
-        } else {
-            Err(format!(
-                "expected a finite number >= 0, found {}",
-                hooke_core::Num(x)
-            ))
+        impl From<$name> for f64 {
+            fn from(x: $name) -> f64 {
+                x.0
+            }
         }
-    }
+    };
 }
 
-impl From<NonNegative> for f64 {
-    fn from(x: NonNegative) -> f64 {
-        x.0
-    }
-}
-
-/// A finite `f64` in `[0, 1]`.
-#[derive(Clone, Copy, Debug, PartialEq, PartialOrd, Serialize, Deserialize)]
-#[serde(try_from = "f64", into = "f64")]
-pub struct Fraction(pub f64);
-
-impl TryFrom<f64> for Fraction {
-    type Error = String;
-    fn try_from(x: f64) -> Result<Self, String> {
-        if (0.0..=1.0).contains(&x) {
-            Ok(Self(x))
-        } else {
-            Err(format!(
-                "expected a number in [0, 1], found {}",
-                hooke_core::Num(x)
-            ))
-        }
-    }
-}
-
-impl From<Fraction> for f64 {
-    fn from(x: Fraction) -> f64 {
-        x.0
-    }
-}
+checked_number!(
+    /// A finite `f64`, refused at read time when NaN or infinite.
+    ///
+    /// ```
+    /// use hooke_scene::spec::Finite;
+    /// assert_eq!(Finite::new(1.5).map(Finite::get), Ok(1.5));
+    /// assert_eq!(Finite::new(f64::NAN).unwrap_err(), "expected a finite number, found NaN");
+    /// ```
+    Finite,
+    "a finite number",
+    |x| x.is_finite()
+);
+checked_number!(
+    /// A finite `f64` greater than zero.
+    Positive,
+    "a finite number > 0",
+    |x| x.is_finite() && x > 0.0
+);
+checked_number!(
+    /// A finite `f64` at least zero.
+    NonNegative,
+    "a finite number >= 0",
+    |x| x.is_finite() && x >= 0.0
+);
+checked_number!(
+    /// A finite `f64` in `[0, 1]`.
+    Fraction,
+    "a number in [0, 1]",
+    |x| x >= 0.0 && x <= 1.0
+);
 
 /// An integrator name, checked at read time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

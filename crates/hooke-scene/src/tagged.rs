@@ -180,9 +180,9 @@ impl TryFrom<ColliderShapeTable> for ColliderShapeSpec {
                 only("mesh", &["path", "translate", "rotate", "scale"], &present)?;
                 ColliderShapeSpec::Mesh {
                     path: need("mesh", "path", t.path)?,
-                    translate: t.translate.unwrap_or([Finite(0.0); 3]),
-                    rotate: t.rotate.unwrap_or([Finite(0.0); 3]),
-                    scale: t.scale.unwrap_or([Positive(1.0); 3]),
+                    translate: t.translate.unwrap_or([Finite::of(0.0); 3]),
+                    rotate: t.rotate.unwrap_or([Finite::of(0.0); 3]),
+                    scale: t.scale.unwrap_or([Positive::of(1.0); 3]),
                 }
             }
         })
@@ -230,7 +230,7 @@ impl TryFrom<ResponseTable> for ResponseSpec {
                 only("restitution", &["cr", "friction"], &present)?;
                 ResponseSpec::Restitution {
                     cr: need("restitution", "cr", t.cr)?,
-                    friction: t.friction.unwrap_or(Fraction(0.0)),
+                    friction: t.friction.unwrap_or(Fraction::of(0.0)),
                 }
             }
             ResponseKind::Stick => {

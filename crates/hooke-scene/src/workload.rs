@@ -20,27 +20,27 @@ pub const WORKLOAD_STEPS: u64 = 200;
 pub fn cloth(n: usize) -> SceneSpec {
     let params = || {
         Some(SpringParams {
-            ks: NonNegative(1000.0),
-            kd: NonNegative(0.01),
+            ks: NonNegative::of(1000.0),
+            kd: NonNegative::of(0.01),
         })
     };
-    let zero = [Finite(0.0); 3];
+    let zero = [Finite::of(0.0); 3];
     SceneSpec {
         name: format!("cloth-{n}"),
         description: format!("the cloth-N benchmark workload at N = {n}"),
         simulation: SimulationSpec {
             integrator: IntegratorName(Integrator::Symplectic),
-            dt: Positive(1e-5),
+            dt: Positive::of(1e-5),
             duration: None,
             steps: Some(WORKLOAD_STEPS),
             every: WORKLOAD_STEPS,
-            gravity: [Finite(0.0), Finite(-9.81), Finite(0.0)],
-            drag: NonNegative(0.0),
+            gravity: [Finite::of(0.0), Finite::of(-9.81), Finite::of(0.0)],
+            drag: NonNegative::of(0.0),
         },
         bodies: vec![BodySpec {
             name: "cloth".into(),
-            mass: Positive(1.0 / (n * n) as f64),
-            origin: [Finite(0.0), Finite(1.0), Finite(0.0)],
+            mass: Positive::of(1.0 / (n * n) as f64),
+            origin: [Finite::of(0.0), Finite::of(1.0), Finite::of(0.0)],
             rotate: zero,
             velocity: zero,
             pins: vec![0, n - 1],
@@ -48,7 +48,7 @@ pub fn cloth(n: usize) -> SceneSpec {
             velocities: None,
             shape: ShapeSpec::Grid {
                 size: [n, n],
-                spacing: Positive(1.0 / (n - 1) as f64),
+                spacing: Positive::of(1.0 / (n - 1) as f64),
             },
             springs: SpringsSpec {
                 structural: params(),
@@ -57,7 +57,7 @@ pub fn cloth(n: usize) -> SceneSpec {
                 pairs: Vec::new(),
             },
             // The workload measures springs alone: no contact phase.
-            thickness: Some(NonNegative(0.0)),
+            thickness: Some(NonNegative::of(0.0)),
             self_collision: None,
             friction: None,
         }],

@@ -104,10 +104,7 @@ const EXCERPT_CHARS: usize = 40;
 
 /// At most [`EXCERPT_CHARS`] characters of `word`, with `…` where it was cut.
 fn excerpt(word: &str) -> String {
-    match word.char_indices().nth(EXCERPT_CHARS) {
-        Some((cut, _)) => format!("{}…", &word[..cut]),
-        None => word.to_string(),
-    }
+    hooke_core::excerpt(word, EXCERPT_CHARS)
 }
 
 impl<'a> Tokens<'a> {
@@ -286,8 +283,41 @@ pub fn parse_world(text: &str, path: &Path) -> Result<World, WorldError> {
 #[error("{0}")]
 pub struct NotAWorld(String);
 
-fn finite3(v: &Vec3) -> [Finite; 3] {
-    [Finite(v.x), Finite(v.y), Finite(v.z)]
+/// A world value that a scene cannot hold (a [`World`] built in code, not read: the reader
+/// refuses these with the file's line).
+#[derive(Debug, thiserror::Error)]
+#[error("world value {key}: {message}")]
+pub struct InvalidWorld {
+    /// The `.w` name of the value, with its index for vectors (`positions[3]`).
+    pub key: String,
+    /// What was expected and found.
+    pub message: String,
+}
+
+/// `checked(x)`, or the error naming `key`.
+fn check<T>(
+    key: impl Fn() -> String,
+    x: f64,
+    checked: fn(f64) -> Result<T, String>,
+) -> Result<T, InvalidWorld> {
+    checked(x).map_err(|message| InvalidWorld {
+        key: key(),
+        message,
+    })
+}
+
+/// The vectors of `list` as finite triples, named `key[i]` when one is not.
+fn finite_list(key: &str, list: &[Vec3]) -> Result<Vec<[Finite; 3]>, InvalidWorld> {
+    list.iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let mut out = [Finite::of(0.0); 3];
+            for (o, c) in out.iter_mut().zip(v.iter()) {
+                *o = check(|| format!("{key}[{i}]"), *c, Finite::new)?;
+            }
+            Ok(out)
+        })
+        .collect()
 }
 
 impl World {
@@ -331,54 +361,59 @@ impl World {
     /// The world as a scene: the 8×8×8 lattice with all three spring families, rest lengths
     /// from the undeformed cube, the box and the plane as penalty colliders, the force field,
     /// no gravity.
-    pub fn to_scene(&self, name: &str) -> SceneSpec {
+    pub fn to_scene(&self, name: &str) -> Result<SceneSpec, InvalidWorld> {
+        let non_negative = |key: &'static str, x| check(|| key.to_string(), x, NonNegative::new);
+        let positive = |key: &'static str, x| check(|| key.to_string(), x, Positive::new);
         let springs = Some(SpringParams {
-            ks: NonNegative(self.k_elastic),
-            kd: NonNegative(self.d_elastic),
+            ks: non_negative("kElastic", self.k_elastic)?,
+            kd: non_negative("dElastic", self.d_elastic)?,
         });
         let penalty = ResponseSpec::Penalty {
-            kc: NonNegative(self.k_collision),
-            dc: NonNegative(self.d_collision),
+            kc: non_negative("kCollision", self.k_collision)?,
+            dc: non_negative("dCollision", self.d_collision)?,
         };
         let mut colliders = vec![ColliderSpec {
             shape: ColliderShapeSpec::Box {
-                min: [Finite(-2.0); 3],
-                max: [Finite(2.0); 3],
+                min: [Finite::of(-2.0); 3],
+                max: [Finite::of(2.0); 3],
             },
             response: penalty,
         }];
         if let Some(c) = self.plane {
+            let mut coefficients = [Finite::of(0.0); 4];
+            for (k, (o, x)) in coefficients.iter_mut().zip(c).enumerate() {
+                *o = check(|| format!("plane[{k}]"), x, Finite::new)?;
+            }
             colliders.push(ColliderSpec {
-                shape: ColliderShapeSpec::Plane {
-                    coefficients: c.map(Finite),
-                },
+                shape: ColliderShapeSpec::Plane { coefficients },
                 response: penalty,
             });
         }
-        SceneSpec {
+        let field = finite_list("forceField", &self.field)?;
+        Ok(SceneSpec {
             name: name.to_string(),
             description: format!("jello world '{name}'"),
             simulation: SimulationSpec {
                 integrator: IntegratorName(self.integrator),
-                dt: Positive(self.dt),
+                dt: positive("dt", self.dt)?,
                 duration: None,
                 steps: Some(DEFAULT_STEPS),
                 every: self.every,
-                gravity: [Finite(0.0); 3],
-                drag: NonNegative(0.0),
+                gravity: [Finite::of(0.0); 3],
+                drag: NonNegative::of(0.0),
             },
             bodies: vec![BodySpec {
                 name: "jello".into(),
-                mass: Positive(self.mass),
-                origin: [Finite(0.0); 3],
-                rotate: [Finite(0.0); 3],
-                velocity: [Finite(0.0); 3],
+                mass: positive("mass", self.mass)?,
+                origin: [Finite::of(0.0); 3],
+                rotate: [Finite::of(0.0); 3],
+                velocity: [Finite::of(0.0); 3],
                 pins: Vec::new(),
-                positions: Some(self.positions.iter().map(finite3).collect()),
-                velocities: Some(self.velocities.iter().map(finite3).collect()),
+                positions: Some(finite_list("positions", &self.positions)?),
+                velocities: Some(finite_list("velocities", &self.velocities)?),
                 shape: ShapeSpec::Lattice {
                     size: [SIDE; 3],
-                    spacing: Positive(SPACING),
+                    spacing: Positive::of(SPACING),
                 },
                 springs: SpringsSpec {
                     structural: springs,
@@ -392,11 +427,11 @@ impl World {
                 friction: None,
             }],
             colliders,
-            force_field: (self.resolution > 0).then(|| ForceFieldSpec {
+            force_field: (self.resolution > 0).then_some(ForceFieldSpec {
                 resolution: self.resolution,
-                values: self.field.iter().map(finite3).collect(),
+                values: field,
             }),
-        }
+        })
     }
 
     /// The scene as a world, when it is one: a single 8×8×8 lattice of spacing 1/7 with equal
@@ -409,7 +444,7 @@ impl World {
         if !matches!(integrator, Integrator::Rk4 | Integrator::Euler) {
             return no("jello worlds know only the rk4 and euler integrators");
         }
-        if sim.gravity.iter().any(|g| g.0 != 0.0) || sim.drag.0 != 0.0 {
+        if sim.gravity.iter().any(|g| g.get() != 0.0) || sim.drag.get() != 0.0 {
             return no("jello worlds have no gravity and no drag (use the force field)");
         }
         let [body] = spec.bodies.as_slice() else {
@@ -418,7 +453,7 @@ impl World {
         if body.shape
             != (ShapeSpec::Lattice {
                 size: [SIDE; 3],
-                spacing: Positive(SPACING),
+                spacing: Positive::of(SPACING),
             })
         {
             return no("the body must be an 8x8x8 lattice of spacing 1/7");
@@ -435,7 +470,7 @@ impl World {
         if !body.pins.is_empty() {
             return no("jello worlds have no pinned points");
         }
-        if body.thickness.is_some_and(|h| h.0 != 0.0) {
+        if body.thickness.is_some_and(|h| h.get() != 0.0) {
             return no("jello worlds have no contact thickness (bare per-particle contacts)");
         }
         let mut penalty = None;
@@ -445,20 +480,20 @@ impl World {
             let ResponseSpec::Penalty { kc, dc } = c.response else {
                 return no("jello colliders are penalty springs");
             };
-            if penalty.is_some_and(|p| p != (kc.0, dc.0)) {
+            if penalty.is_some_and(|p| p != (kc.get(), dc.get())) {
                 return no("all colliders must share kCollision and dCollision");
             }
-            penalty = Some((kc.0, dc.0));
+            penalty = Some((kc.get(), dc.get()));
             match &c.shape {
                 ColliderShapeSpec::Box { min, max }
-                    if min.iter().all(|x| x.0 == -2.0)
-                        && max.iter().all(|x| x.0 == 2.0)
+                    if min.iter().all(|x| x.get() == -2.0)
+                        && max.iter().all(|x| x.get() == 2.0)
                         && !has_box =>
                 {
                     has_box = true
                 }
                 ColliderShapeSpec::Plane { coefficients } if plane.is_none() => {
-                    plane = Some(coefficients.map(|x| x.0))
+                    plane = Some(coefficients.map(|x| x.get()))
                 }
                 _ => return no("colliders must be the [-2, 2]^3 box and at most one plane"),
             }
@@ -466,11 +501,11 @@ impl World {
         let Some((k_collision, d_collision)) = penalty.filter(|_| has_box) else {
             return no("a jello world needs the [-2, 2]^3 box collider");
         };
-        let v3 = |v: &[Finite; 3]| Vec3::new(v[0].0, v[1].0, v[2].0);
+        let v3 = |v: &[Finite; 3]| Vec3::new(v[0].get(), v[1].get(), v[2].get());
         let positions = match &body.positions {
             Some(ps) => ps.iter().map(v3).collect(),
             None => {
-                let r = body.rotate.map(|a| a.0.to_radians());
+                let r = body.rotate.map(|a| a.get().to_radians());
                 let rot = nalgebra::Rotation3::from_euler_angles(r[0], r[1], r[2]);
                 let lattice = crate::generators::Lattice { size: [SIDE; 3] };
                 lattice
@@ -490,13 +525,13 @@ impl World {
         };
         Ok(World {
             integrator,
-            dt: sim.dt.0,
+            dt: sim.dt.get(),
             every: sim.every,
-            k_elastic: p.ks.0,
-            d_elastic: p.kd.0,
+            k_elastic: p.ks.get(),
+            d_elastic: p.kd.get(),
             k_collision,
             d_collision,
-            mass: body.mass.0,
+            mass: body.mass.get(),
             plane,
             resolution,
             field,
