@@ -24,6 +24,7 @@ mod bins;
 mod camera;
 mod draw_list;
 mod raster;
+mod resolve;
 mod setup;
 mod shading;
 mod tile;

@@ -13,10 +13,10 @@
 use crate::bins::{Bins, Grid};
 use crate::camera::Camera;
 use crate::draw_list::{DrawList, Rgb};
+use crate::resolve::Resolver;
 use crate::setup::{Frame, LineSetup, PointSetup, Projected, Rect, TriSetup};
 use crate::shading::Shading;
-use crate::tile::{EMPTY, Samples};
-use nalgebra::Vector3;
+use crate::tile::Samples;
 use rayon::prelude::*;
 
 /// How to render.
@@ -46,198 +46,6 @@ impl Default for RenderOptions {
 /// Tile side in output pixels: with 4× supersampling a tile's depth and id buffers take
 /// 128 KiB, which stays in a core's L2 cache.
 pub const TILE: u32 = 64;
-
-/// Everything the resolve needs to shade a sample's primitive.
-struct Prepared<'a> {
-    list: &'a DrawList,
-    /// [`Renderer::mesh_start`].
-    mesh_start: &'a [usize],
-    tris: &'a [Option<TriSetup>],
-    lines: &'a [Option<LineSetup>],
-    points: &'a [Option<PointSetup>],
-    shading: Shading,
-    options: &'a RenderOptions,
-    ss: u32,
-}
-
-/// What a primitive shows at one point.
-enum Surface {
-    /// An unlit colour: background and lines.
-    Flat(Rgb),
-    /// A base colour lit with a normal.
-    Lit(Vector3<f64>, Rgb),
-}
-
-impl Prepared<'_> {
-    /// What primitive `id` shows at the sample-space point `p`.
-    fn surface(&self, id: u32, p: (f64, f64)) -> Surface {
-        let id = id as usize;
-        let (nt, nl) = (self.tris.len(), self.lines.len());
-        if id < nt {
-            let Some(s) = &self.tris[id] else {
-                return Surface::Flat([0.0; 3]);
-            };
-            if s.tiny {
-                return Surface::Lit(s.normal, s.color);
-            }
-            let (n, color) = self.corner_normals(s.src as usize);
-            let w = s.weights(p);
-            Surface::Lit(n[0] * w[0] + n[1] * w[1] + n[2] * w[2], color)
-        } else if id < nt + nl {
-            Surface::Flat(self.lines[id - nt].map_or([0.0; 3], |l| l.color))
-        } else {
-            let Some(s) = &self.points[id - nt - nl] else {
-                return Surface::Flat([0.0; 3]);
-            };
-            let (u, v) = ((p.0 - s.c.0) / s.radius, (s.c.1 - p.1) / s.radius);
-            let r2 = (u * u + v * v).min(1.0);
-            let n = self.shading.right * u + self.shading.up * v
-                - self.shading.forward * (1.0 - r2).sqrt();
-            Surface::Lit(n, s.color)
-        }
-    }
-
-    /// The corner normals and colour of set-up triangle `id`: a mesh's, or after the
-    /// meshes' the list's own. Only triangles that were set up are asked for, and set-up
-    /// checked their corners.
-    fn corner_normals(&self, id: usize) -> ([Vector3<f64>; 3], Rgb) {
-        let meshes_end = self.mesh_start[self.mesh_start.len() - 1];
-        if id < meshes_end {
-            let m = self.mesh_start.partition_point(|&start| start <= id) - 1;
-            let mesh = &self.list.meshes[m];
-            let corners = mesh.triangles[id - self.mesh_start[m]];
-            (corners.map(|c| mesh.normals[c as usize]), mesh.color)
-        } else {
-            let t = &self.list.triangles[id - meshes_end];
-            (t.n, t.color)
-        }
-    }
-
-    fn background(&self, row: u32) -> Rgb {
-        let t = (row as f32 + 0.5) / self.options.height as f32;
-        let [top, bottom] = self.options.background;
-        [0, 1, 2].map(|c| top[c] * (1.0 - t) + bottom[c] * t)
-    }
-
-    /// The first output pixel `(x, y)` of a tile of samples and its size in pixels.
-    fn pixels_of(&self, area: &Rect) -> ((u32, u32), (u32, u32)) {
-        let ss = self.ss;
-        let first = (area.x0 / ss, area.y0 / ss);
-        (first, ((area.x1 - area.x0) / ss, (area.y1 - area.y0) / ss))
-    }
-
-    /// The background of a tile that no primitive touches, row-major over the tile: what
-    /// [`Prepared::resolve`] gives for it, without clearing and reading its samples (most
-    /// tiles of a still where the subject fills a third of the frame).
-    fn background_tile(&self, area: &Rect, out: &mut Vec<u8>) {
-        let ((_, py0), (w, h)) = self.pixels_of(area);
-        out.clear();
-        out.resize((w * h * 4) as usize, 0);
-        for (y, pixels) in (0..h).zip(out.chunks_exact_mut((w * 4) as usize)) {
-            let pixel = rgba8(self.background(py0 + y));
-            for p in pixels.chunks_exact_mut(4) {
-                p.copy_from_slice(&pixel);
-            }
-        }
-    }
-
-    /// Shades and averages the tile's samples into RGBA8 pixels, row-major over the tile.
-    fn resolve(&self, s: &Samples, out: &mut Vec<u8>) {
-        let ss = self.ss;
-        let ((px0, py0), (w, h)) = self.pixels_of(&s.area);
-        let weight = 1.0 / (ss * ss) as f32;
-        out.clear();
-        out.resize((w * h * 4) as usize, 0);
-        // Distinct primitives of one pixel and their sample counts (at most 16 samples), and
-        // its distinct lit materials: reused from pixel to pixel (only the first `distinct`
-        // or `materials` entries are read), as clearing 16 materials per edge pixel cost a
-        // tenth of a cloth-256 frame.
-        let mut ids = [(0u32, 0u32); 16];
-        let mut lit: [(Rgb, Vector3<f64>, u32); 16] = [([0.0; 3], Vector3::zeros(), 0); 16];
-        for (y, pixels) in (0..h).zip(out.chunks_exact_mut((w * 4) as usize)) {
-            let background = self.background(py0 + y);
-            let row = s.index(s.area.x0, s.area.y0 + y * ss);
-            for (x, pixel) in (0..w).zip(pixels.chunks_exact_mut(4)) {
-                let first = row + (x * ss) as usize;
-                let mut distinct = 0;
-                for sy in 0..ss as usize {
-                    for sx in 0..ss as usize {
-                        let id = s.id[first + sy * s.stride + sx];
-                        match ids[..distinct].iter_mut().find(|(i, _)| *i == id) {
-                            Some((_, count)) => *count += 1,
-                            None => {
-                                ids[distinct] = (id, 1);
-                                distinct += 1;
-                            }
-                        }
-                    }
-                }
-                let centre = (
-                    ((px0 + x) * ss) as f64 + ss as f64 * 0.5,
-                    ((py0 + y) * ss) as f64 + ss as f64 * 0.5,
-                );
-                let c = if distinct == 1 && ids[0].0 == EMPTY {
-                    background
-                } else if distinct == 1 {
-                    match self.surface(ids[0].0, centre) {
-                        Surface::Flat(c) => c,
-                        Surface::Lit(n, c) => self.shading.shade(n, c),
-                    }
-                } else {
-                    // Samples of one base colour are lit once with their summed normals:
-                    // where a smooth mesh's triangles are pixel-sized, a pixel shades once
-                    // per material rather than once per triangle, and looks the same.
-                    let mut sum = [0.0f32; 3];
-                    let mut materials = 0;
-                    for &(id, count) in &ids[..distinct] {
-                        let surface = if id == EMPTY {
-                            Surface::Flat(background)
-                        } else {
-                            self.surface(id, centre)
-                        };
-                        match surface {
-                            Surface::Flat(c) => {
-                                for k in 0..3 {
-                                    sum[k] += c[k] * count as f32;
-                                }
-                            }
-                            Surface::Lit(n, c) => {
-                                match lit[..materials].iter_mut().find(|m| m.0 == c) {
-                                    Some(m) => {
-                                        m.1 += n * count as f64;
-                                        m.2 += count;
-                                    }
-                                    None => {
-                                        lit[materials] = (c, n * count as f64, count);
-                                        materials += 1;
-                                    }
-                                }
-                            }
-                        }
-                    }
-                    for (c, n, count) in &lit[..materials] {
-                        let c = self.shading.shade(*n, *c);
-                        for k in 0..3 {
-                            sum[k] += c[k] * *count as f32;
-                        }
-                    }
-                    sum.map(|v| v * weight)
-                };
-                pixel.copy_from_slice(&rgba8(c));
-            }
-        }
-    }
-}
-
-/// An opaque RGBA8 pixel of colour `c`, each channel clamped to `[0, 1]`.
-#[inline]
-fn rgba8(c: Rgb) -> [u8; 4] {
-    // Truncating `v + 0.5` rounds: `f32::round` is a libm call per channel. The value is
-    // in [0.5, 255.5] (or NaN, which gives 0 either way), so going through i32 skips the
-    // saturating u8 conversion's extra tests.
-    let channel = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as i32 as u8;
-    [channel(c[0]), channel(c[1]), channel(c[2]), 255]
-}
 
 /// Renders `list` seen by `camera` into an RGBA8 image of `width × height` pixels, row-major.
 ///
@@ -303,10 +111,10 @@ impl Renderer {
     /// Renders `list` seen by `camera` into an RGBA8 image of `width × height` pixels,
     /// row-major. The pixels depend only on the arguments, never on earlier frames.
     pub fn render(&mut self, list: &DrawList, camera: &Camera, options: &RenderOptions) -> Vec<u8> {
-        let ss = options.supersample.max(1);
-        let (w, h) = (options.width * ss, options.height * ss);
+        let supersample = options.supersample.max(1);
+        let (w, h) = (options.width * supersample, options.height * supersample);
         let frame = Frame::new(camera, w, h);
-        let per_pixel = ss as f64;
+        let per_pixel = supersample as f64;
         let [tri_rects, line_rects, point_rects] = &mut self.rects;
         let (mut tris, mut rects) = sized(&mut self.tris, tri_rects, list.triangle_count());
         self.mesh_start.clear();
@@ -354,11 +162,11 @@ impl Renderer {
             |_, p| PointSetup::new(&frame, p, per_pixel),
             |p| p.rect,
         );
-        let grid = Grid::new(w, h, TILE * ss);
+        let grid = Grid::new(w, h, TILE * supersample);
         self.tri_bins.fill(&self.rects[0], &grid);
         self.line_bins.fill(&self.rects[1], &grid);
         self.point_bins.fill(&self.rects[2], &grid);
-        let prepared = Prepared {
+        let resolver = Resolver {
             list,
             mesh_start: &self.mesh_start,
             tris: &self.tris,
@@ -366,9 +174,13 @@ impl Renderer {
             points: &self.points,
             shading: Shading::new(camera),
             options,
-            ss,
+            supersample,
         };
-        let (nt, nl) = (self.tris.len() as u32, self.lines.len() as u32);
+        // Sample ids: triangles, then lines, then points.
+        let (line_ids, point_ids) = (
+            self.tris.len() as u32,
+            (self.tris.len() + self.lines.len()) as u32,
+        );
         let (tri_bins, line_bins, point_bins) = (&self.tri_bins, &self.line_bins, &self.point_bins);
 
         self.tiles.resize_with(grid.count(), Vec::new);
@@ -384,27 +196,27 @@ impl Renderer {
                 };
                 let bins = [tri_bins, line_bins, point_bins];
                 if bins.iter().all(|b| b.tile(t).next().is_none()) {
-                    prepared.background_tile(&area, pixels);
+                    resolver.background_tile(&area, pixels);
                     return;
                 }
                 samples.reset(area);
                 // Binned primitives are the set-up ones: the `if let` never skips.
                 for id in tri_bins.tile(t) {
-                    if let Some(s) = &prepared.tris[id as usize] {
+                    if let Some(s) = &resolver.tris[id as usize] {
                         samples.triangle(s, id);
                     }
                 }
                 for id in line_bins.tile(t) {
-                    if let Some(s) = &prepared.lines[id as usize] {
-                        samples.line(s, nt + id);
+                    if let Some(s) = &resolver.lines[id as usize] {
+                        samples.line(s, line_ids + id);
                     }
                 }
                 for id in point_bins.tile(t) {
-                    if let Some(s) = &prepared.points[id as usize] {
-                        samples.point(s, nt + nl + id);
+                    if let Some(s) = &resolver.points[id as usize] {
+                        samples.point(s, point_ids + id);
                     }
                 }
-                prepared.resolve(samples, pixels);
+                resolver.resolve(samples, pixels);
             },
         );
 
@@ -426,6 +238,7 @@ impl Renderer {
 mod tests {
     use super::*;
     use crate::draw_list::{Line, Mesh, Point};
+    use nalgebra::Vector3;
 
     fn scene() -> DrawList {
         let mut list = DrawList::default();
