@@ -7,6 +7,7 @@ use hooke_core::Num;
 use hooke_scene::Scene;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
+use std::time::{Duration, Instant};
 
 /// Runs shorter than this many steps show no progress bar.
 const PROGRESS_FROM: u64 = 10_000;
@@ -113,4 +114,32 @@ pub fn advance(scene: &mut Scene, n: u64) -> Result<()> {
     steps(scene, n, &bar)?;
     bar.finish_and_clear();
     Ok(())
+}
+
+/// Steps `scene` through `owed` seconds of simulated time in whole steps, as a viewer
+/// keeping pace with the wall clock does, stopping early when `budget` of wall-clock time is
+/// spent or an interrupt arrives. Returns the time still owed: under one step, or zero when
+/// the budget ran out (the backlog is dropped, so a slow scene runs slower than real time
+/// instead of falling ever further behind).
+///
+/// ```
+/// use std::time::Duration;
+/// let mut scene = hooke_cli::source::build("chain", &Default::default()).unwrap();
+/// let dt = scene.simulation.dt();
+/// let left = hooke_cli::driver::catch_up(&mut scene, 10.5 * dt, Duration::from_secs(60)).unwrap();
+/// assert_eq!(scene.simulation.steps(), 10);
+/// assert!((left - 0.5 * dt).abs() < 1e-12);
+/// ```
+pub fn catch_up(scene: &mut Scene, mut owed: f64, budget: Duration) -> Result<f64> {
+    let sim = &mut scene.simulation;
+    let (dt, started) = (sim.dt(), Instant::now());
+    while owed >= dt {
+        interrupt::check(sim)?;
+        sim.step()?;
+        owed -= dt;
+        if started.elapsed() > budget {
+            return Ok(0.0);
+        }
+    }
+    Ok(owed)
 }

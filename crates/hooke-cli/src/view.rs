@@ -11,7 +11,7 @@ use crate::image_out::write_png;
 use crate::source;
 use anyhow::{Context, Result};
 use font8x8::UnicodeFonts;
-use hooke_cli::interrupt;
+use hooke_cli::{driver, interrupt};
 use hooke_core::{Attachment, SpringKind, Vec3};
 use hooke_render::{Camera, RenderOptions, Renderer};
 use hooke_scene::{Overrides, Scene};
@@ -58,6 +58,22 @@ struct Grab {
     ndc_depth: f64,
 }
 
+/// Which lattice spring families the springs style draws (springs of no family always are).
+#[derive(Clone, Copy, Debug)]
+struct Families {
+    structural: bool,
+    shear: bool,
+    bend: bool,
+}
+
+impl Families {
+    const ALL: Self = Self {
+        structural: true,
+        shear: true,
+        bend: true,
+    };
+}
+
 struct Viewer {
     scenes: Vec<String>,
     current: usize,
@@ -66,8 +82,8 @@ struct Viewer {
     home: Camera,
     paused: bool,
     style: Style,
-    /// Structural, shear, bend shown in the springs style.
-    kinds: [bool; 3],
+    /// The spring families shown in the springs style (s / h / b toggle them).
+    families: Families,
     /// Wall-clock time owed to the simulation, seconds.
     owed: f64,
     message: Option<String>,
@@ -98,7 +114,7 @@ impl Viewer {
             home: camera,
             paused: false,
             style: Style::Solid,
-            kinds: [true; 3],
+            families: Families::ALL,
             owed: 0.0,
             message: None,
             grab: None,
@@ -136,35 +152,27 @@ impl Viewer {
         self.camera.pitch = (self.camera.pitch + dy as f64 * 0.4).clamp(-89.0, 89.0);
     }
 
-    /// Advances the simulation by `wall` seconds of wall-clock time, in whole steps.
+    /// Advances the simulation by `wall` seconds of wall-clock time, in whole steps, within
+    /// [`MAX_SIM_SHARE`] of a frame.
     fn simulate(&mut self, wall: f64) {
         if self.paused || self.message.is_some() {
             return;
         }
-        let sim = &mut self.scene.simulation;
-        let dt = sim.dt();
-        self.owed += wall;
-        let started = Instant::now();
         let budget = Duration::from_secs_f64(MAX_SIM_SHARE * FRAME);
-        while self.owed >= dt {
-            if let Err(e) = sim.step() {
-                self.message = Some(format!("{e}"));
-                return;
-            }
-            self.owed -= dt;
-            if started.elapsed() > budget {
-                // Behind the clock: drop the backlog instead of spiralling.
-                self.owed = 0.0;
-                break;
-            }
+        match driver::catch_up(&mut self.scene, self.owed + wall, budget) {
+            Ok(owed) => self.owed = owed,
+            // The window loop sees the interrupt itself and closes.
+            Err(e) if interrupt::is_interrupt(&e) => self.owed = 0.0,
+            Err(e) => self.message = Some(format!("{e}")),
         }
     }
 
     fn show(&self, kind: SpringKind) -> bool {
+        let f = &self.families;
         match kind {
-            SpringKind::Structural => self.kinds[0],
-            SpringKind::Shear => self.kinds[1],
-            SpringKind::Bend => self.kinds[2],
+            SpringKind::Structural => f.structural,
+            SpringKind::Shear => f.shear,
+            SpringKind::Bend => f.bend,
             SpringKind::Other => true,
         }
     }
@@ -350,9 +358,9 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
                         _ => Style::Solid,
                     }
                 }
-                Key::S => viewer.kinds[0] = !viewer.kinds[0],
-                Key::H => viewer.kinds[1] = !viewer.kinds[1],
-                Key::B => viewer.kinds[2] = !viewer.kinds[2],
+                Key::S => viewer.families.structural ^= true,
+                Key::H => viewer.families.shear ^= true,
+                Key::B => viewer.families.bend ^= true,
                 Key::E => viewer.camera = viewer.home,
                 Key::Z => viewer.zoom(0.9),
                 Key::X => viewer.zoom(1.0 / 0.9),
