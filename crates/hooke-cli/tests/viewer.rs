@@ -2,8 +2,8 @@
 //! xdotool, and the viewer's own screenshots (SPACE) show that the picture moves over time
 //! and changes with TAB.
 //!
-//! Needs `Xvfb` and `xdotool` (`.ci/run` installs them). Without them the test is skipped
-//! with a message, except on CI (`CI` set), where that is a failure.
+//! Needs `Xvfb` and `xdotool` (`cargo xtask test` installs them). Without them the test
+//! fails with what to install, unless `HOOKE_SKIP_VIEWER` is set.
 
 use image::RgbaImage;
 use std::path::{Path, PathBuf};
@@ -69,11 +69,15 @@ fn changed(a: &RgbaImage, b: &RgbaImage, top: u32, bottom: u32) -> usize {
 #[test]
 fn viewer_animates_and_tab_switches_scenes_under_xvfb() {
     if !(available("Xvfb") && available("xdotool")) {
+        // Skipping is a decision someone makes, never a default: a passing run says the
+        // viewer was tested.
         assert!(
-            std::env::var_os("CI").is_none(),
-            "CI must install Xvfb and xdotool (see .ci/run)"
+            std::env::var_os("HOOKE_SKIP_VIEWER").is_some(),
+            "the viewer test needs Xvfb and xdotool: run the tests with `cargo xtask test`, \
+             which installs them (apt-get install xvfb xdotool), or set HOOKE_SKIP_VIEWER=1 \
+             to skip this test"
         );
-        eprintln!("skipped: Xvfb or xdotool not installed");
+        eprintln!("skipped: HOOKE_SKIP_VIEWER is set and Xvfb or xdotool is not installed");
         return;
     }
     let number = 40 + std::process::id() % 50;
