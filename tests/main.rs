@@ -3,6 +3,7 @@
 //! One test binary (fast to link) with a module per concern. Physics tests compare with
 //! closed forms; snapshot tests lock real trajectories (see `tests/snapshots/`).
 
+mod air;
 mod collisions;
 mod common;
 mod conservation;

@@ -133,4 +133,5 @@ scene_snapshots! {
     snapshot_hanging_cloth => "hanging-cloth",
     snapshot_cloth_table => "cloth-table",
     snapshot_cloth_pile => "cloth-pile",
+    snapshot_flag => "flag",
 }

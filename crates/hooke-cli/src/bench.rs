@@ -8,6 +8,7 @@ use crate::source;
 use anyhow::{Context, Result, bail};
 use hooke_core::{Integrator, Kernel, Simulation};
 use hooke_render::{RenderOptions, Renderer};
+use hooke_scene::spec::{AeroSpec, AirSpec, Finite, NonNegative, Positive};
 use hooke_scene::workload;
 use hooke_scene::{Overrides, Scene};
 use image::{ImageFormat, RgbaImage};
@@ -37,6 +38,10 @@ pub enum Bench {
         /// Force-loop compilation (default: the widest this CPU runs).
         #[arg(long)]
         kernel: Option<Kernel>,
+        /// The workload in moving air (density 1.225 kg/m³, wind (2, 0, 1) m/s, drag 1,
+        /// lift 0.3 on every triangle): compare with a run without it for the cost of air.
+        #[arg(long)]
+        air: bool,
         /// Print one JSON object instead of text.
         #[arg(long)]
         json: bool,
@@ -101,6 +106,8 @@ struct ClothFigures {
     threads: usize,
     integrator: String,
     kernel: String,
+    /// Whether the workload ran in moving air (`--air`).
+    air: bool,
     springs: usize,
     seconds: f64,
     steps_per_s: f64,
@@ -205,7 +212,7 @@ fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
     builder.build().context("cannot start the worker threads")
 }
 
-fn workload(n: usize, steps: u64, integrator: Integrator) -> Result<Scene> {
+fn workload(n: usize, steps: u64, integrator: Integrator, air: bool) -> Result<Scene> {
     if !(3..=2048).contains(&n) {
         bail!("--n: expected a cloth size from 3 to 2048, found {n}");
     }
@@ -213,6 +220,18 @@ fn workload(n: usize, steps: u64, integrator: Integrator) -> Result<Scene> {
         bail!("--steps: expected at least 1");
     }
     let mut spec = workload::cloth(n);
+    if air {
+        let f3 = |v: [f64; 3]| v.map(Finite::of);
+        spec.simulation.air = Some(AirSpec {
+            density: Positive::of(hooke_core::air::SEA_LEVEL_DENSITY),
+            wind: f3([2.0, 0.0, 1.0]),
+            gust: None,
+        });
+        spec.bodies[0].aero = Some(AeroSpec {
+            drag: NonNegative::of(1.0),
+            lift: Finite::of(0.3),
+        });
+    }
     Overrides {
         integrator: Some(integrator),
         steps: Some(steps),
@@ -230,8 +249,9 @@ pub fn run(bench: &Bench) -> Result<ExitCode> {
             threads,
             integrator,
             kernel,
+            air,
             json,
-        } => pool(*threads)?.install(|| cloth(*n, *steps, *integrator, *kernel, *json)),
+        } => pool(*threads)?.install(|| cloth(*n, *steps, *integrator, *kernel, *air, *json)),
         Bench::Scene {
             scene,
             steps,
@@ -285,14 +305,15 @@ fn cloth(
     steps: u64,
     integrator: Integrator,
     kernel: Option<Kernel>,
+    air: bool,
     json: bool,
 ) -> Result<ExitCode> {
     // Warm-up on a separate copy: page in the buffers and start the workers, so the measured
     // run starts from the workload's initial state.
-    let mut warm = workload(n, steps, integrator)?;
+    let mut warm = workload(n, steps, integrator, air)?;
     use_kernel(&mut warm.simulation, kernel)?;
     warm.simulation.advance(steps.min(20))?;
-    let mut scene = workload(n, steps, integrator)?;
+    let mut scene = workload(n, steps, integrator, air)?;
     use_kernel(&mut scene.simulation, kernel)?;
     let (times, seconds) = StepTimes::run(&mut scene.simulation, steps, |_| ())?;
     let springs = scene.simulation.model().springs.len();
@@ -302,6 +323,7 @@ fn cloth(
         threads: rayon::current_num_threads(),
         integrator: integrator.to_string(),
         kernel: scene.simulation.workspace().kernel().to_string(),
+        air,
         springs,
         seconds,
         steps_per_s: steps as f64 / seconds,
@@ -315,9 +337,10 @@ fn cloth(
         println!("{}", serde_json::to_string(&figures)?);
     } else {
         println!(
-            "cloth N={n}: {springs} springs, {steps} {integrator} steps on {} threads ({} \
+            "cloth N={n}{}: {springs} springs, {steps} {integrator} steps on {} threads ({} \
              kernel) in {:.3} s: {:.1} steps/s, {:.1} M spring updates/s; median step {:.3} \
              ms ({:.1} M/s), fastest {:.3} ms; centre y = {:.12}",
+            if air { " in air" } else { "" },
             figures.threads,
             figures.kernel,
             seconds,
@@ -428,7 +451,7 @@ fn renders(
             .strip_prefix("cloth-")
             .and_then(|n| n.parse::<usize>().ok());
         let scene = match grid {
-            Some(n) => workload(n, 1, Integrator::Symplectic)
+            Some(n) => workload(n, 1, Integrator::Symplectic, false)
                 .with_context(|| format!("target {target}"))?,
             None => {
                 let mut scene = source::build(target, &Overrides::default())?;

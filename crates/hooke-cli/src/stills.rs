@@ -24,14 +24,16 @@ pub fn still_scene(name: &str) -> Result<Scene> {
 
 /// The view of built-in scene `name`'s still, from the user's `view`.
 pub fn still_view(name: &str, view: &View) -> View {
-    // The cloth hangs in the y-z plane from its pins: look at its face, not its edge.
-    if name == "hanging-cloth" {
-        View {
-            yaw: view.yaw + 35.0,
-            ..view.clone()
-        }
-    } else {
-        view.clone()
+    // The cloth hangs in the y-z plane from its pins, the flag streams in the x-y plane:
+    // look at their faces, not their edges.
+    let turn = match name {
+        "hanging-cloth" => 35.0,
+        "flag" => -30.0,
+        _ => 0.0,
+    };
+    View {
+        yaw: view.yaw + turn,
+        ..view.clone()
     }
 }
 

@@ -12,7 +12,7 @@ use crate::source;
 use anyhow::{Context, Result};
 use font8x8::UnicodeFonts;
 use hooke_cli::{driver, interrupt};
-use hooke_core::{Attachment, SpringKind, Vec3};
+use hooke_core::{Air, Attachment, SpringKind, Vec3};
 use hooke_render::{Camera, RenderOptions, Renderer};
 use hooke_scene::{Overrides, Scene};
 use image::RgbaImage;
@@ -26,7 +26,7 @@ use std::time::{Duration, Instant};
 #[derive(clap::Args)]
 pub struct ViewArgs {
     /// Scenes to cycle through with TAB: built-in names, .toml scenes or .w worlds
-    /// (default: the six built-ins).
+    /// (default: the seven built-ins).
     scenes: Vec<String>,
     /// Window size as WIDTHxHEIGHT.
     #[arg(long, default_value = "800x600", value_parser = crate::image_out::parse_size)]
@@ -44,7 +44,7 @@ pub struct ViewArgs {
 
 const HELP: [&str; 2] = [
     "TAB scene  R replay  drag rotate  SHIFT+drag/wheel/Z/X zoom  right-drag grab",
-    "P pause  V solid/springs  S/H/B struct/shear/bend  E camera  SPACE screenshot  ESC quit",
+    "P pause  V solid/springs  S/H/B struct/shear/bend  W wind  E camera  SPACE shot  ESC quit",
 ];
 
 /// At most this share of a frame's time is spent simulating (at 30 frames per second).
@@ -84,6 +84,9 @@ struct Viewer {
     style: Style,
     /// The spring families shown in the springs style (s / h / b toggle them).
     families: Families,
+    /// The scene's air while W has turned its wind off (the air itself stays: a cloth
+    /// still meets drag as it moves).
+    windless: Option<Air>,
     /// Wall-clock time owed to the simulation, seconds.
     owed: f64,
     message: Option<String>,
@@ -115,6 +118,7 @@ impl Viewer {
             paused: false,
             style: Style::Solid,
             families: Families::ALL,
+            windless: None,
             owed: 0.0,
             message: None,
             grab: None,
@@ -132,7 +136,23 @@ impl Viewer {
         self.owed = 0.0;
         self.message = None;
         self.grab = None;
+        self.windless = None;
         Ok(())
+    }
+
+    /// Turns the scene's wind (and gusts) off, or back on; scenes without air have none.
+    fn toggle_wind(&mut self) {
+        let sim = &mut self.scene.simulation;
+        if let Some(air) = self.windless.take() {
+            sim.set_air(Some(air));
+        } else if let Some(air) = sim.model().air.clone() {
+            sim.set_air(Some(Air {
+                wind: Vec3::zeros(),
+                gust: None,
+                ..air.clone()
+            }));
+            self.windless = Some(air);
+        }
     }
 
     /// Restarts the current scene, keeping the camera.
@@ -361,6 +381,7 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
                 Key::S => viewer.families.structural ^= true,
                 Key::H => viewer.families.shear ^= true,
                 Key::B => viewer.families.bend ^= true,
+                Key::W => viewer.toggle_wind(),
                 Key::E => viewer.camera = viewer.home,
                 Key::Z => viewer.zoom(0.9),
                 Key::X => viewer.zoom(1.0 / 0.9),
@@ -416,13 +437,18 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
         }
         let sim = &viewer.scene.simulation;
         let status = format!(
-            "{} ({}/{})  t = {:.2} s  {:.0} fps  {}{}",
+            "{} ({}/{})  t = {:.2} s  {:.0} fps  {}{}{}",
             viewer.scene.spec.name,
             viewer.current + 1,
             viewer.scenes.len(),
             sim.time(),
             fps,
             sim.integrator(),
+            if viewer.windless.is_some() {
+                "  WIND OFF"
+            } else {
+                ""
+            },
             if viewer.paused { "  PAUSED" } else { "" }
         );
         text(&mut buffer, w, h, 8, 8, &status);

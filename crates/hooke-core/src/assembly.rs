@@ -358,18 +358,26 @@ impl Assembly {
     }
 
     /// Scatters at `(x, v)`, then sets `out[p] = map(p, F_p)` for every particle, `F_p` its
-    /// total force, in parallel blocks.
+    /// total force, in parallel blocks. `extra` holds per-particle forces evaluated
+    /// elsewhere (the air's), added to the springs'; empty for none.
     pub fn forces(
         &mut self,
         model: &Model,
         mass: &[f64],
         (x, v): (&[Vec3], &[Vec3]),
+        extra: &[Vec3],
         out: &mut [Vec3],
         map: impl Fn(usize, Vec3) -> Vec3 + Sync + Send,
     ) {
         self.scatter(x, v);
         self.map_gathered(out, |p, springs| {
-            map(p, model.total_force(p, mass[p], &x[p], &v[p], springs))
+            // Without extra forces nothing is added, so their absence keeps every bit.
+            let pairwise = if extra.is_empty() {
+                springs
+            } else {
+                springs + extra[p]
+            };
+            map(p, model.total_force(p, mass[p], &x[p], &v[p], pairwise))
         });
     }
 
@@ -391,16 +399,17 @@ impl Assembly {
         }
     }
 
-    /// `a = F(x, v) / m` for every particle; pinned particles get zero.
+    /// `a = F(x, v) / m` for every particle, with `extra` as in [`Assembly::forces`];
+    /// pinned particles get zero.
     pub fn accelerations(
         &mut self,
         model: &Model,
         (mass, inv_mass): (&[f64], &[f64]),
-        x: &[Vec3],
-        v: &[Vec3],
+        (x, v): (&[Vec3], &[Vec3]),
+        extra: &[Vec3],
         a: &mut [Vec3],
     ) {
-        self.forces(model, mass, (x, v), a, |p, f| {
+        self.forces(model, mass, (x, v), extra, a, |p, f| {
             if inv_mass[p] == 0.0 {
                 Vec3::zeros()
             } else {

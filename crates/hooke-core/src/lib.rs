@@ -30,6 +30,7 @@
 //!
 //! Build with `--release`: unoptimised nalgebra arithmetic is tens of times slower.
 
+pub mod air;
 mod assembly;
 mod collider;
 pub mod contact;
@@ -49,6 +50,7 @@ mod stability;
 mod summary;
 mod surface;
 
+pub use air::{AeroSurface, Air, Gust};
 pub use assembly::Assembly;
 pub use collider::{Collider, Contact, Feature};
 pub use contact::ContactStats;

@@ -1,5 +1,6 @@
 //! The force model of a system: everything that is constant during a run.
 
+use crate::air::{AeroSurface, Air};
 use crate::collider::{Collider, Contact};
 use crate::force_field::ForceField;
 use crate::parallel;
@@ -38,6 +39,11 @@ pub struct Model {
     /// The bodies' surfaces that take part in contacts (see [`crate::contact`]); empty for
     /// systems of bare particles, whose contacts are the per-particle tests of docs/physics.md §3.3 alone.
     pub surfaces: Vec<Surface>,
+    /// The air the system moves in; `None` for vacuum (no drag or lift beyond `drag`).
+    pub air: Option<Air>,
+    /// The bodies' triangles that air acts on, with their coefficients (only read when
+    /// `air` is set).
+    pub aero: Vec<AeroSurface>,
 }
 
 /// A zero-length damped spring from a particle to a point in space: the force
@@ -58,12 +64,13 @@ pub struct Attachment {
 const CONTACT_BLOCK: usize = 256;
 
 impl Model {
-    /// Whether gravity is the only force besides the springs (no field, drag, penalty
+    /// Whether gravity is the only force besides the springs (no field, drag, air, penalty
     /// colliders or attachments): integrators then use a loop without the per-particle
     /// tests of [`Model::external_force`], whose result it equals to the bit.
     pub fn gravity_only(&self) -> bool {
         self.field.is_none()
             && self.drag == 0.0
+            && self.air.is_none()
             && self.attachments.is_empty()
             && self.colliders.iter().all(|c| !c.response.is_force())
     }

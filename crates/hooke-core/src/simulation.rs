@@ -4,6 +4,7 @@
 //! then the divergence check of [`crate::divergence`], which trusts the integrator's verdict
 //! unless contacts moved particles after it.
 
+use crate::air::Air;
 use crate::contact::{self, ContactState, ContactStats};
 use crate::divergence::{self, Divergence, StepEnd};
 use crate::integrator::{Integrator, StepReport, Workspace};
@@ -85,6 +86,12 @@ impl Simulation {
         self.model.attachments = attachments;
     }
 
+    /// Replaces the air the system moves in (`None`: vacuum), e.g. to turn the wind off and
+    /// on; takes effect from the next step. The surfaces air acts on stay the model's.
+    pub fn set_air(&mut self, air: Option<Air>) {
+        self.model.air = air;
+    }
+
     /// Runs the force loop compiled for `kernel` (see [`Kernel`]); the widest available is
     /// the default. A kernel the CPU lacks is refused with the best it has.
     pub fn set_kernel(&mut self, kernel: Kernel) -> Result<(), Kernel> {
@@ -140,11 +147,12 @@ impl Simulation {
 
     /// [`Simulation::step`] on the current thread.
     fn step_here(&mut self) -> Result<(), Divergence> {
+        let time = self.time();
         let report = self.integrator.step(
             &self.model,
             &mut self.particles,
-            self.dt,
             &mut self.workspace,
+            (time, self.dt),
             &self.contacts.held,
         );
         self.last = report;

@@ -3,11 +3,11 @@
 use crate::generators::Lattice;
 use crate::spec::*;
 use hooke_collide::{BoxInterior, Cylinder, MeshError, Placement, Plane, TriMeshCollider};
+use hooke_core::{AeroSurface, Air, Gust, Num, SANE_BOUND};
 use hooke_core::{
     Collider, ColliderSlot, DEFAULT_CLOTH_THICKNESS, DEFAULT_SURFACE_FRICTION, ForceField, Model,
     Particles, Response, Simulation, Spring, SpringKind, Surface, Vec3,
 };
-use hooke_core::{Num, SANE_BOUND};
 use nalgebra::Rotation3;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -197,6 +197,7 @@ impl SceneSpec {
         let mut springs = Vec::new();
         let mut bodies = Vec::new();
         let mut surfaces = Vec::new();
+        let mut aero = Vec::new();
         for (b, body) in self.bodies.iter().enumerate() {
             let key = format!("body[{b}] '{}'", body.name);
             // Exports and messages name bodies: two of one name could not be told apart.
@@ -290,6 +291,9 @@ impl SceneSpec {
             springs.extend(built.springs);
             let triangles = crate::surface::triangles(built.topology, start);
             let surface = body_surface(body, &key, &built.local, start..start + n, triangles)?;
+            if let Some(a) = body_aero(body, &key, &surface.triangles, self.simulation.air)? {
+                aero.push(a);
+            }
             bodies.push(Body {
                 name: body.name.clone(),
                 range: start..start + n,
@@ -357,6 +361,15 @@ impl SceneSpec {
             colliders: slots,
             attachments: Vec::new(),
             surfaces,
+            air: self.simulation.air.map(|a| Air {
+                density: a.density.get(),
+                wind: vec3(&a.wind),
+                gust: a.gust.map(|g| Gust {
+                    amplitude: vec3(&g.amplitude),
+                    period: g.period.get(),
+                }),
+            }),
+            aero,
         };
         let simulation = Simulation::new(
             particles,
@@ -373,6 +386,30 @@ impl SceneSpec {
             colliders: geometry,
         })
     }
+}
+
+/// The triangles of a body that the air acts on, with its coefficients: none without air.
+fn body_aero(
+    body: &BodySpec,
+    key: &str,
+    triangles: &[[u32; 3]],
+    air: Option<AirSpec>,
+) -> Result<Option<AeroSurface>, BuildError> {
+    if body.aero.is_some() && triangles.is_empty() {
+        return Err(invalid(
+            format!("{key}.aero"),
+            "only bodies with a surface (grid, lattice) feel air; remove it",
+        ));
+    }
+    if air.is_none() || triangles.is_empty() {
+        return Ok(None);
+    }
+    let coefficients = body.aero.unwrap_or_default();
+    Ok(Some(AeroSurface {
+        triangles: triangles.to_vec(),
+        drag: coefficients.drag.get(),
+        lift: coefficients.lift.get(),
+    }))
 }
 
 /// The contact surface of a body: its triangles with the thickness, self-collision and

@@ -1,4 +1,5 @@
-//! The five built-in scenes of the course document, defined in code.
+//! The built-in scenes: the course document's five, a cloth pile for self-contact and a flag
+//! in the wind, defined in code.
 //!
 //! Each is also shipped as `assets/scenes/<name>.toml` (written by `hooke scene NAME`), and a
 //! test checks that every file equals its built-in. Parameters were chosen so that each scene
@@ -28,6 +29,7 @@ fn sim(integrator: Integrator, dt: f64, duration: f64, every: u64, drag: f64) ->
         every,
         gravity: f3([0.0, -9.81, 0.0]),
         drag: NonNegative::of(drag),
+        air: None,
     }
 }
 
@@ -52,6 +54,7 @@ fn body(
         thickness: None,
         self_collision: None,
         friction: None,
+        aero: None,
     }
 }
 
@@ -276,17 +279,85 @@ pub fn cloth_pile() -> SceneSpec {
     }
 }
 
+/// Radius of the flag's pole, metres.
+pub const POLE_RADIUS: f64 = 0.03;
+
+/// A 1.5 m × 1 m flag (30 × 20 particles, 0.22 kg) pinned along its hoist to a pole, in a
+/// 6 m/s wind along +x with gusts that also swing it sideways: it streams out from the pole
+/// and flutters. Air acts through drag and a little lift on its triangles.
+pub fn flag() -> SceneSpec {
+    let (fly, hoist) = (30, 20);
+    let spacing = 1.5 / (fly - 1) as f64;
+    let mut b = body(
+        "flag",
+        0.22 / (fly * hoist) as f64,
+        // The hoist starts 1 cm off the pole, 2 m up.
+        [POLE_RADIUS + 0.01, 2.0, 0.0],
+        ShapeSpec::Grid {
+            size: [fly, hoist],
+            spacing: Positive::of(spacing),
+        },
+        SpringsSpec {
+            structural: params(300.0, 0.02),
+            shear: params(150.0, 0.02),
+            bend: params(1.0, 0.002),
+            pairs: Vec::new(),
+        },
+    );
+    // Rotated about x, the grid's local z runs up: particles 0..hoist are the hoist.
+    b.rotate = f3([-90.0, 0.0, 0.0]);
+    b.pins = (0..hoist).collect();
+    b.aero = Some(AeroSpec {
+        drag: NonNegative::of(1.0),
+        lift: Finite::of(0.3),
+    });
+    let mut simulation = sim(Integrator::Symplectic, 2.5e-4, 5.0, 120, 0.0);
+    simulation.air = Some(AirSpec {
+        density: Positive::of(hooke_core::air::SEA_LEVEL_DENSITY),
+        wind: f3([6.0, 0.0, 0.0]),
+        gust: Some(GustSpec {
+            amplitude: f3([2.0, 0.0, 2.5]),
+            period: Positive::of(1.7),
+        }),
+    });
+    let pole_top = 3.1;
+    SceneSpec {
+        name: "flag".into(),
+        description: "a 1.5 x 1 m flag on a pole in a gusting 6 m/s wind; streams out and flutters"
+            .into(),
+        simulation,
+        bodies: vec![b],
+        colliders: vec![
+            ground(0.2, 0.5),
+            ColliderSpec {
+                shape: ColliderShapeSpec::Cylinder {
+                    center: f3([0.0, pole_top, 0.0]),
+                    radius: Positive::of(POLE_RADIUS),
+                    thickness: Positive::of(pole_top),
+                },
+                response: ResponseSpec::Restitution {
+                    cr: Fraction::of(0.0),
+                    friction: Fraction::of(0.3),
+                },
+            },
+        ],
+        force_field: None,
+    }
+}
+
 /// Makes a built-in scene.
 pub type Maker = fn() -> SceneSpec;
 
-/// The built-in scenes by name: the course document's five, then the contact scene.
-pub const BUILTINS: [(&str, Maker); 6] = [
+/// The built-in scenes by name: the course document's five, then the contact scene and the
+/// air scene.
+pub const BUILTINS: [(&str, Maker); 7] = [
     ("single-spring", single_spring),
     ("chain", chain),
     ("jello-cube", jello_cube),
     ("hanging-cloth", hanging_cloth),
     ("cloth-table", cloth_table),
     ("cloth-pile", cloth_pile),
+    ("flag", flag),
 ];
 
 /// The built-in scene called `name`.

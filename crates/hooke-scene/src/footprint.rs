@@ -140,9 +140,17 @@ impl SceneSpec {
                     }
                 }
             }
-            // A grid has a surface with a thickness unless it is set to zero.
-            let surface = matches!(body.shape, ShapeSpec::Grid { .. })
-                && body.thickness.is_none_or(|t| t.get() > 0.0);
+            // A grid has a surface with a thickness unless it is set to zero; in air, grids
+            // and lattices keep their triangles and per-triangle forces, which cost about
+            // what a contact surface does (an upper bound for a lattice, whose surface is
+            // only its skin).
+            let has_triangles = matches!(
+                body.shape,
+                ShapeSpec::Grid { .. } | ShapeSpec::Lattice { .. }
+            );
+            let surface = (matches!(body.shape, ShapeSpec::Grid { .. })
+                && body.thickness.is_none_or(|t| t.get() > 0.0))
+                || (has_triangles && self.simulation.air.is_some());
             let surface_particles = if surface { particles } else { 0 };
             f.particles = f.particles.saturating_add(particles);
             f.springs = f.springs.saturating_add(springs);

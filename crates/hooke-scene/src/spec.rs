@@ -157,6 +157,73 @@ pub struct SimulationSpec {
     /// Linear drag on every particle in N·s/m (default 0).
     #[serde(default = "zero", skip_serializing_if = "is_zero")]
     pub drag: NonNegative,
+    /// The air that bodies with a surface (grids, lattices) move in: drag and lift per
+    /// triangle (docs/physics.md §1, "Air"). Absent: vacuum.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub air: Option<AirSpec>,
+}
+
+/// `[simulation] air = { density = 1.225, wind = [wx, wy, wz], gust = { … } }`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AirSpec {
+    /// Density in kg/m³ (default 1.225, sea level).
+    #[serde(default = "sea_level")]
+    pub density: Positive,
+    /// The steady wind velocity in m/s (default still air).
+    #[serde(default = "still")]
+    pub wind: [Finite; 3],
+    /// A periodic gust on top of the wind.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust: Option<GustSpec>,
+}
+
+fn sea_level() -> Positive {
+    Positive::of(hooke_core::air::SEA_LEVEL_DENSITY)
+}
+
+fn still() -> [Finite; 3] {
+    [Finite::of(0.0); 3]
+}
+
+/// `gust = { amplitude = [ax, ay, az], period = T }`: the wind plus
+/// `amplitude · sin(2π t / T)`, a smooth function of time with no random state.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GustSpec {
+    /// The largest change of the wind, m/s.
+    pub amplitude: [Finite; 3],
+    /// Seconds from one gust to the next.
+    pub period: Positive,
+}
+
+/// A body's aerodynamic coefficients: `aero = { drag = C_d, lift = C_l }`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AeroSpec {
+    /// Drag coefficient (default 1, a flat plate face-on).
+    #[serde(default = "unit_drag")]
+    pub drag: NonNegative,
+    /// Lift coefficient (default 0).
+    #[serde(default = "no_lift")]
+    pub lift: Finite,
+}
+
+impl Default for AeroSpec {
+    fn default() -> Self {
+        Self {
+            drag: unit_drag(),
+            lift: no_lift(),
+        }
+    }
+}
+
+fn unit_drag() -> NonNegative {
+    NonNegative::of(1.0)
+}
+
+fn no_lift() -> Finite {
+    Finite::of(0.0)
 }
 
 fn default_gravity() -> [Finite; 3] {
@@ -216,6 +283,10 @@ pub struct BodySpec {
     /// Coulomb friction coefficient of the surface against surfaces (default 0.3).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction: Option<NonNegative>,
+    /// Drag and lift coefficients for the air of `[simulation] air` (default drag 1, lift 0;
+    /// only bodies with a surface feel air).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aero: Option<AeroSpec>,
 }
 
 fn origin() -> [Finite; 3] {

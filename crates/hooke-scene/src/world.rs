@@ -401,6 +401,7 @@ impl World {
                 every: self.every,
                 gravity: [Finite::of(0.0); 3],
                 drag: NonNegative::of(0.0),
+                air: None,
             },
             bodies: vec![BodySpec {
                 name: "jello".into(),
@@ -425,6 +426,7 @@ impl World {
                 thickness: None,
                 self_collision: None,
                 friction: None,
+                aero: None,
             }],
             colliders,
             force_field: (self.resolution > 0).then_some(ForceFieldSpec {
@@ -446,6 +448,9 @@ impl World {
         }
         if sim.gravity.iter().any(|g| g.get() != 0.0) || sim.drag.get() != 0.0 {
             return no("jello worlds have no gravity and no drag (use the force field)");
+        }
+        if sim.air.is_some() {
+            return no("jello worlds have no air (use the force field)");
         }
         let [body] = spec.bodies.as_slice() else {
             return no("a jello world has exactly one body");

@@ -44,7 +44,7 @@ pub struct ImplicitBuffers {
 pub(super) fn step(
     model: &Model,
     p: &mut Particles,
-    dt: f64,
+    (t, dt): (f64, f64),
     ws: &mut Workspace,
     held: &[bool],
 ) -> StepReport {
@@ -57,7 +57,9 @@ pub(super) fn step(
 
     // Forces at the current state.
     let [f0, b, dv, r] = &mut ws.kv;
-    asm.forces(model, &p.mass, (&p.x, &p.v), f0, |_, f| f);
+    // Air is taken at the step's start and left out of the Jacobian (docs/physics.md §4).
+    let air = ws.air.evaluate(model, &p.x, &p.v, t);
+    asm.forces(model, &p.mass, (&p.x, &p.v), air, f0, |_, f| f);
 
     // Jacobian blocks and the system's per-spring blocks.
     blocks::spring_blocks(asm, &p.x, &mut buffers.blocks);

@@ -11,6 +11,7 @@ mod midpoint;
 mod rk4;
 mod symplectic;
 
+use crate::air::AirForces;
 use crate::assembly::{Assembly, BLOCK};
 use crate::kernel::Kernel;
 use crate::model::Model;
@@ -95,7 +96,8 @@ impl Integrator {
         }
     }
 
-    /// Advances `particles` by `dt` seconds under `model`, without collision responses.
+    /// Advances `particles` from time `t` by `dt` seconds under `model`, without collision
+    /// responses (`t` matters to forces that vary in time, such as a gusting wind).
     /// `held` marks particles a stick response holds (the implicit scheme keeps them out of
     /// its solve; the explicit ones leave that to the responses); a particle past its end
     /// is not held, so `&[]` holds none. Returns what the step
@@ -104,17 +106,17 @@ impl Integrator {
         self,
         model: &Model,
         particles: &mut Particles,
-        dt: f64,
         ws: &mut Workspace,
+        (t, dt): (f64, f64),
         held: &[bool],
     ) -> StepReport {
         ws.ensure(model, particles.len());
         match self {
-            Self::Euler => euler::step(model, particles, dt, ws),
-            Self::Symplectic => symplectic::step(model, particles, dt, ws),
-            Self::Midpoint => midpoint::step(model, particles, dt, ws),
-            Self::Rk4 => rk4::step(model, particles, dt, ws),
-            Self::Implicit => implicit::step(model, particles, dt, ws, held),
+            Self::Euler => euler::step(model, particles, (t, dt), ws),
+            Self::Symplectic => symplectic::step(model, particles, (t, dt), ws),
+            Self::Midpoint => midpoint::step(model, particles, (t, dt), ws),
+            Self::Rk4 => rk4::step(model, particles, (t, dt), ws),
+            Self::Implicit => implicit::step(model, particles, (t, dt), ws, held),
         }
     }
 }
@@ -178,6 +180,8 @@ pub struct Workspace {
     pub(crate) vt: Vec<Vec3>,
     /// The implicit integrator's blocks and preconditioner.
     pub(crate) implicit: implicit::ImplicitBuffers,
+    /// The air forces' incidences and buffers.
+    pub(crate) air: AirForces,
     /// The force loop's compilation, when not the detected one.
     pub(crate) kernel: Option<Kernel>,
 }
@@ -198,6 +202,7 @@ impl Workspace {
         if let Some(kernel) = self.kernel {
             self.assembly.set_kernel(kernel);
         }
+        self.air.ensure(model, particles);
         let zero = Vec3::zeros();
         for buf in [&mut self.x0, &mut self.xt, &mut self.vt]
             .into_iter()
@@ -220,16 +225,17 @@ impl Workspace {
     }
 }
 
-/// `a = F(x, v) / m` with the workspace's assembly.
+/// `a = F(x, v, t) / m` with the workspace's assembly and air forces.
 fn accelerations(
     model: &Model,
-    assembly: &mut Assembly,
+    (assembly, air): (&mut Assembly, &mut AirForces),
     p: &Particles,
-    x: &[Vec3],
-    v: &[Vec3],
+    (x, v): (&[Vec3], &[Vec3]),
+    t: f64,
     a: &mut [Vec3],
 ) {
-    assembly.accelerations(model, (&p.mass, &p.inv_mass), x, v, a);
+    let extra = air.evaluate(model, x, v, t);
+    assembly.accelerations(model, (&p.mass, &p.inv_mass), (x, v), extra, a);
 }
 
 /// Per-particle updates in parallel blocks of [`BLOCK`] particles.

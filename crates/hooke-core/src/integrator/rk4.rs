@@ -7,12 +7,18 @@ use crate::particles::Particles;
 /// `|1 + z + z²/2 + z³/6 + z⁴/24| ≤ 1` on the imaginary axis up to `|z| = 2√2`.
 pub(super) const STABILITY_RADIUS: f64 = 2.0 * std::f64::consts::SQRT_2;
 
-pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) -> StepReport {
+pub(super) fn step(
+    model: &Model,
+    p: &mut Particles,
+    (t, dt): (f64, f64),
+    ws: &mut Workspace,
+) -> StepReport {
     let half = 0.5 * dt;
     ws.x0.copy_from_slice(&p.x);
     // Stage 1 at the current state; its position derivative is the velocity itself.
     ws.kx[0].copy_from_slice(&p.v);
-    accelerations(model, &mut ws.assembly, p, &p.x, &p.v, &mut ws.kv[0]);
+    let parts = (&mut ws.assembly, &mut ws.air);
+    accelerations(model, parts, p, (&p.x, &p.v), t, &mut ws.kv[0]);
     // Stages 2..4 at s + c·dt·k_{stage-1}, with c = 1/2, 1/2, 1.
     for (stage, c) in [(1, half), (2, half), (3, dt)] {
         trial(
@@ -23,14 +29,8 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
             &mut ws.vt,
         );
         ws.kx[stage].copy_from_slice(&ws.vt);
-        accelerations(
-            model,
-            &mut ws.assembly,
-            p,
-            &ws.xt,
-            &ws.vt,
-            &mut ws.kv[stage],
-        );
+        let parts = (&mut ws.assembly, &mut ws.air);
+        accelerations(model, parts, p, (&ws.xt, &ws.vt), t + c, &mut ws.kv[stage]);
     }
     let sixth = dt / 6.0;
     let [k1x, k2x, k3x, k4x] = &ws.kx;

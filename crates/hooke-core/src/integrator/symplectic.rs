@@ -14,13 +14,18 @@ use crate::particles::{Particles, SANE_BOUND, Vec3};
 /// Symplectic Euler keeps an undamped oscillation bounded while `ω dt < 2`.
 pub(super) const STABILITY_RADIUS: f64 = 2.0;
 
-pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace) -> StepReport {
+pub(super) fn step(
+    model: &Model,
+    p: &mut Particles,
+    (t, dt): (f64, f64),
+    ws: &mut Workspace,
+) -> StepReport {
     let save = model.has_contact_phase();
     let sane = match (model.gravity_only(), save) {
-        (true, true) => update::<true, true>(model, p, dt, ws),
-        (true, false) => update::<true, false>(model, p, dt, ws),
-        (false, true) => update::<false, true>(model, p, dt, ws),
-        (false, false) => update::<false, false>(model, p, dt, ws),
+        (true, true) => update::<true, true>(model, p, (t, dt), ws),
+        (true, false) => update::<true, false>(model, p, (t, dt), ws),
+        (false, true) => update::<false, true>(model, p, (t, dt), ws),
+        (false, false) => update::<false, false>(model, p, (t, dt), ws),
     };
     StepReport {
         saved_start: save,
@@ -34,9 +39,10 @@ pub(super) fn step(model: &Model, p: &mut Particles, dt: f64, ws: &mut Workspace
 fn update<const GRAVITY_ONLY: bool, const SAVE_START: bool>(
     model: &Model,
     p: &mut Particles,
-    dt: f64,
+    (t, dt): (f64, f64),
     ws: &mut Workspace,
 ) -> bool {
+    let air = ws.air.evaluate(model, &p.x, &p.v, t);
     ws.assembly.scatter(&p.x, &p.v);
     let asm = &ws.assembly;
     let (mass, inv_mass) = (&p.mass, &p.inv_mass);
@@ -60,7 +66,13 @@ fn update<const GRAVITY_ONLY: bool, const SAVE_START: bool>(
                 let f = if GRAVITY_ONLY {
                     model.gravity * mass[k] + springs[k]
                 } else {
-                    model.total_force(start + k, mass[k], &x[k], &v[k], springs[k])
+                    // Without air nothing is added, so vacuum runs keep every bit.
+                    let pairwise = if air.is_empty() {
+                        springs[k]
+                    } else {
+                        springs[k] + air[start + k]
+                    };
+                    model.total_force(start + k, mass[k], &x[k], &v[k], pairwise)
                 };
                 v[k] += f * inv_mass[k] * dt;
                 x[k] += v[k] * dt;
