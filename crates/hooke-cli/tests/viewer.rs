@@ -1,6 +1,6 @@
 //! `hooke view` in a real window: an X server (Xvfb) is started, keys are sent with
-//! xdotool, and the viewer's own screenshots (SPACE) show that the picture moves over time
-//! and changes with TAB.
+//! xdotool, and the viewer's own screenshots (SPACE) show that the picture moves over time,
+//! changes with TAB, and that W stills the flag's wind.
 //!
 //! Needs `Xvfb` and `xdotool` (`cargo xtask test` installs them). Without them the test
 //! fails with what to install, unless `HOOKE_SKIP_VIEWER` is set.
@@ -66,8 +66,21 @@ fn changed(a: &RgbaImage, b: &RgbaImage, top: u32, bottom: u32) -> usize {
         .count()
 }
 
+/// The columns holding the flag's saturated blue (the sky's blue is pale), between rows
+/// `top..bottom`.
+fn flag_width(image: &RgbaImage, top: u32, bottom: u32) -> usize {
+    (0..image.width())
+        .filter(|&x| {
+            (top..bottom).any(|y| {
+                let [r, _, b, _] = image.get_pixel(x, y).0;
+                b as i32 - r as i32 > 80
+            })
+        })
+        .count()
+}
+
 #[test]
-fn viewer_animates_and_tab_switches_scenes_under_xvfb() {
+fn viewer_animates_tab_switches_scenes_and_w_stills_the_wind_under_xvfb() {
     if !(available("Xvfb") && available("xdotool")) {
         // Skipping is a decision someone makes, never a default: a passing run says the
         // viewer was tested.
@@ -98,7 +111,14 @@ fn viewer_animates_and_tab_switches_scenes_under_xvfb() {
     std::fs::create_dir_all(&shots).unwrap();
     let mut viewer = Reaper(
         Command::new(env!("CARGO_BIN_EXE_hooke"))
-            .args(["view", "hanging-cloth", "chain", "--size", "400x300"])
+            .args([
+                "view",
+                "hanging-cloth",
+                "chain",
+                "flag",
+                "--size",
+                "400x300",
+            ])
             .arg("--screenshots")
             .arg(&shots)
             .env("DISPLAY", &display)
@@ -135,6 +155,13 @@ fn viewer_animates_and_tab_switches_scenes_under_xvfb() {
     key("Tab");
     sleep(Duration::from_millis(500));
     key("space");
+    // The flag streams in its wind; W turns the wind off and it drops against the pole.
+    key("Tab");
+    sleep(Duration::from_millis(1500));
+    key("space");
+    key("w");
+    sleep(Duration::from_millis(2500));
+    key("space");
     key("Escape");
 
     let status = until(Duration::from_secs(10), || {
@@ -161,7 +188,9 @@ fn viewer_animates_and_tab_switches_scenes_under_xvfb() {
         [
             "hooke-hanging-cloth-001.png",
             "hooke-hanging-cloth-002.png",
-            "hooke-chain-003.png"
+            "hooke-chain-003.png",
+            "hooke-flag-004.png",
+            "hooke-flag-005.png"
         ],
         "screenshots in {}",
         shots.display()
@@ -180,6 +209,11 @@ fn viewer_animates_and_tab_switches_scenes_under_xvfb() {
     assert!(
         switched > 5000,
         "TAB should show another scene: {switched} pixels changed"
+    );
+    let [windy, calm] = [&files[3], &files[4]].map(|p| flag_width(&load(p), top, bottom));
+    assert!(
+        windy > 60 && calm * 5 < windy * 3,
+        "W should still the wind: the flag spans {windy} columns in the wind, {calm} without"
     );
 
     // Ctrl-C closes the viewer with the status every interrupted command has.
