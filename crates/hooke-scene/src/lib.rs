@@ -21,6 +21,7 @@
 mod build;
 pub mod builtin;
 pub mod collider_mesh;
+mod edit;
 pub mod footprint;
 pub mod generators;
 mod overrides;
