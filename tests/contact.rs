@@ -4,7 +4,7 @@
 //! independent of the solver's proximity code.
 
 use crate::common::{builtin, root};
-use hooke_cli::obj_export::ObjExport;
+use hooke_cli::export::obj::ObjExport;
 use hooke_core::{Integrator, Model, Particles, Simulation, Surface, Vec3, contact::ContactStats};
 use hooke_scene::Overrides;
 use std::path::{Path, PathBuf};
@@ -131,7 +131,7 @@ fn export_run(name: &str, table: Option<&str>) -> (PathBuf, u64) {
         std::process::id()
     ));
     let _ = std::fs::remove_dir_all(&dir);
-    let export = ObjExport::new(&dir, &scene).unwrap();
+    let mut export = ObjExport::new(&dir, &scene).unwrap();
     export.frame(0, &scene).unwrap();
     let frames = scene.steps / scene.every;
     for f in 1..=frames {

@@ -6,10 +6,10 @@
 
 pub mod draw;
 pub mod driver;
+pub mod export;
 pub mod image_out;
 pub mod interrupt;
 pub mod memory;
-pub mod obj_export;
 pub mod output;
 pub mod source;
 pub mod stills;

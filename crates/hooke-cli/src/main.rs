@@ -148,10 +148,17 @@ struct RunArgs {
     /// Write the frames as a looping GIF animation.
     #[arg(long, value_name = "FILE.gif")]
     gif: Option<PathBuf>,
-    /// Write every frame as a Wavefront OBJ (DIR/frame-00000.obj, ...) in world coordinates:
-    /// bodies as `body:<name>`, colliders as `collider:<index>-<kind>`.
-    #[arg(long, value_name = "DIR")]
-    export_obj: Option<PathBuf>,
+    /// Export the frames for other tools, the format from the path: FILE.usda (a USD stage,
+    /// Y-up, metres, a time code per frame), FILE.pc2 (Blender's point cache of one body,
+    /// with its mesh as FILE.obj beside it) or DIR/ with --format (a file per frame).
+    #[arg(long, value_name = "PATH")]
+    export: Option<PathBuf>,
+    /// The files of a folder export: ply (binary, with normals) or obj (with colliders).
+    #[arg(long, requires = "export")]
+    format: Option<hooke_cli::export::FolderFormat>,
+    /// The body a .pc2 export caches (default: the scene's first).
+    #[arg(long, value_name = "NAME", requires = "export")]
+    body: Option<String>,
     #[command(flatten)]
     view: image_out::View,
 }

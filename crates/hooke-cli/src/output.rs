@@ -76,6 +76,15 @@ impl AtomicFile {
         self.writer.as_mut().expect("writer present until commit")
     }
 
+    /// What was written so far, read from the start: for a scratch file that is copied into
+    /// another and then dropped (which removes it).
+    pub fn read_back(&mut self) -> Result<File> {
+        self.writer()
+            .flush()
+            .with_context(|| format!("cannot write {}", self.target.display()))?;
+        File::open(&self.temp).with_context(|| format!("cannot read back {}", self.temp.display()))
+    }
+
     /// Flushes, syncs and renames the file into place.
     pub fn commit(mut self) -> Result<()> {
         let writer = self.writer.take().expect("commit once");
@@ -194,7 +203,10 @@ pub fn check_output_file(path: &Path, flag: &str, extensions: &[&str]) -> Result
 /// Checks, before a run, that `dir` (given with option `flag`) can be an output folder: it
 /// is one, or nothing is there yet (it is created when the run starts).
 pub fn check_output_folder(dir: &Path, flag: &str) -> Result<()> {
-    if dir.exists() && !dir.is_dir() {
+    // `file/` does not exist as a path (the file is no folder), but `file` does.
+    let text = dir.to_string_lossy();
+    let bare = Path::new(text.trim_end_matches(['/', std::path::MAIN_SEPARATOR]));
+    if (dir.exists() && !dir.is_dir()) || (bare.exists() && !bare.is_dir()) {
         bail!("{flag} {}: is a file, expected a folder", dir.display());
     }
     Ok(())

@@ -5,6 +5,7 @@ use crate::trajectory::TrajectoryWriter;
 use crate::{RunArgs, SetupArgs};
 use anyhow::{Context, Result, bail};
 use hooke_cli::driver::drive;
+use hooke_cli::export::{Exporter, Target};
 use hooke_cli::interrupt::{self, is_interrupt};
 use hooke_cli::output::{check_output_file, check_output_folder};
 use hooke_core::Num;
@@ -161,14 +162,14 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
     if let Some(path) = &args.gif {
         check_output_file(path, "--gif", &["gif"])?;
     }
-    for (dir, flag) in [
-        (&args.frames, "--frames"),
-        (&args.export_obj, "--export-obj"),
-    ] {
-        if let Some(dir) = dir {
-            check_output_folder(dir, flag)?;
-        }
+    if let Some(dir) = &args.frames {
+        check_output_folder(dir, "--frames")?;
     }
+    let export_target = args
+        .export
+        .as_deref()
+        .map(|path| Target::new(path, args.format, args.body.as_deref()))
+        .transpose()?;
     let overrides = Overrides {
         every: args.every,
         ..args.setup.overrides()?
@@ -202,12 +203,11 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         args.view.clone(),
         every as f64 * dt,
     )?;
-    let export = match &args.export_obj {
-        Some(dir) => Some(hooke_cli::obj_export::ObjExport::new(dir, &scene)?),
-        None => None,
-    };
+    let mut export = export_target
+        .map(|target| Exporter::create(&target, &scene))
+        .transpose()?;
     let result = drive(&mut scene, |frame, scene| {
-        if let Some(e) = &export {
+        if let Some(e) = export.as_mut() {
             e.frame(frame, scene)?;
         }
         let sim = &scene.simulation;
@@ -242,6 +242,9 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         }
         if let Some(f) = frames {
             f.finish()?;
+        }
+        if let Some(e) = export {
+            eprintln!("export: {}", e.finish()?);
         }
     }
     if let Err(e) = &result

@@ -84,7 +84,11 @@ const ANNOUNCE_BYTES: u64 = 256 << 20;
 /// Reads and builds the scene named by `arg` with command-line overrides. A scene whose
 /// estimated memory exceeds the budget ([`crate::memory`]) is refused before it is built.
 pub fn build(arg: &str, overrides: &Overrides) -> Result<Scene> {
-    let mut source = read(arg)?;
+    build_from(read(arg)?, arg, overrides)
+}
+
+/// [`build`] for a scene already read (and perhaps edited) from `arg`.
+pub fn build_from(mut source: Source, arg: &str, overrides: &Overrides) -> Result<Scene> {
     // The overrides come from the command line: name its options, not the scene's keys.
     overrides.apply(&mut source.spec).map_err(|e| {
         let e = match e {

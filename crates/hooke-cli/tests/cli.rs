@@ -1,41 +1,9 @@
 //! The `hooke` binary as a user runs it.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn hooke(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hooke"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
-}
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .unwrap()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("hooke-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// The names of the files in `dir`.
-fn file_names(dir: &Path) -> Vec<String> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use common::*;
+use std::path::Path;
 
 /// `hooke run SCENE --steps N --every K --trajectory CSV` in `dir`, which must succeed;
 /// returns the trajectory's text.
@@ -278,8 +246,8 @@ fn the_table_can_be_swapped_from_the_command_line() {
 #[test]
 fn ctrl_c_stops_a_run_at_a_complete_frame() {
     let dir = scratch("sigint");
-    let child = Command::new(env!("CARGO_BIN_EXE_hooke"))
-        .args([
+    let child = spawn(
+        &[
             "run",
             "chain",
             "--duration",
@@ -292,18 +260,12 @@ fn ctrl_c_stops_a_run_at_a_complete_frame() {
             "frames",
             "--size",
             "64x48",
-        ])
-        .current_dir(&dir)
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
+        ],
+        &dir,
+    );
     // Let it write some frames, then interrupt.
     std::thread::sleep(std::time::Duration::from_millis(1500));
-    let status = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(status.success());
+    interrupt(&child);
     let out = child.wait_with_output().unwrap();
     assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
     assert!(
@@ -444,7 +406,7 @@ fn bench_cloth_prints_the_workload_figures_as_json() {
 }
 
 #[test]
-fn export_obj_writes_a_frame_file_per_frame_with_named_objects() {
+fn an_obj_export_writes_a_frame_file_per_frame_with_named_objects() {
     let dir = scratch("export-obj");
     let o = hooke(
         &[
@@ -456,8 +418,10 @@ fn export_obj_writes_a_frame_file_per_frame_with_named_objects() {
             "80",
             "--every",
             "40",
-            "--export-obj",
-            "objs",
+            "--export",
+            "objs/",
+            "--format",
+            "obj",
         ],
         &dir,
     );
@@ -485,7 +449,10 @@ fn export_obj_writes_a_frame_file_per_frame_with_named_objects() {
 
     // A file where the folder should be: refused before anything runs.
     std::fs::write(dir.join("taken"), "x").unwrap();
-    let o = hooke(&["run", "chain", "--export-obj", "taken"], &dir);
+    let o = hooke(
+        &["run", "chain", "--export", "taken/", "--format", "obj"],
+        &dir,
+    );
     assert!(!o.status.success());
     assert!(
         stderr(&o).contains("is a file, expected a folder"),

@@ -3,73 +3,11 @@
 //! than the machine, records long animations. Each case gets a clear refusal or a correct
 //! result; nothing is lost, nothing is left behind, nothing panics.
 
+mod common;
+
+use common::*;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
-use std::time::{Duration, Instant};
-
-fn hooke_in(dir: &Path) -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_hooke"));
-    c.current_dir(dir);
-    c
-}
-
-fn hooke(args: &[&str], dir: &Path) -> Output {
-    hooke_in(dir).args(args).output().unwrap()
-}
-
-fn spawn(args: &[&str], dir: &Path) -> Child {
-    hooke_in(dir)
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("hooke-robust-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn interrupt(child: &Child) {
-    let status = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(status.success());
-}
-
-/// Files under `dir` (recursively) whose names mark an unfinished write.
-fn temporaries(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    for entry in std::fs::read_dir(dir).unwrap().flatten() {
-        let path = entry.path();
-        if path.is_dir() {
-            out.extend(temporaries(&path));
-        } else if path.to_string_lossy().ends_with(".tmp") {
-            out.push(path);
-        }
-    }
-    out
-}
-
-/// Waits until `ready()` or panics after a minute (a slow machine, not a hang, is expected).
-fn wait_for(what: &str, mut ready: impl FnMut() -> bool) {
-    let start = Instant::now();
-    while !ready() {
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "timed out waiting for {what}"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-}
+use std::time::Duration;
 
 fn count_files(dir: &Path, ext: &str) -> usize {
     std::fs::read_dir(dir).map_or(0, |d| {
@@ -181,7 +119,13 @@ fn unusable_output_paths_are_refused_before_the_run() {
         (vec!["--gif", "a.png"], "ending in .gif"),
         (vec!["--gif", "out"], "is a folder"),
         (vec!["--frames", "file.txt"], "expected a folder"),
-        (vec!["--export-obj", "file.txt"], "expected a folder"),
+        (
+            vec!["--export", "file.txt/", "--format", "obj"],
+            "expected a folder",
+        ),
+        (vec!["--export", "out"], "a folder export needs --format"),
+        (vec!["--export", "missing/run.usda"], "does not exist"),
+        (vec!["--export", "run.abc"], "ending in .usda or .pc2"),
     ];
     for (extra, expect) in cases {
         let args: Vec<&str> = endless.iter().copied().chain(extra).collect();

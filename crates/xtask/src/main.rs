@@ -1,11 +1,12 @@
-//! `cargo xtask test`: the README's test command. It installs the system packages the tests
-//! need when they are missing (the viewer test's X server, key sender and X libraries, as
-//! Debian packages through `apt-get`), then runs `cargo test --workspace` with any further
-//! arguments passed through.
+//! `cargo xtask test`: the README's test command. It installs what the tests need when it is
+//! missing — the viewer test's X server, key sender and X libraries as Debian packages
+//! through `apt-get`; the export checks' Python packages (`usd-core`, `numpy`) into a
+//! virtual environment, `target/python` — then runs `cargo test --workspace` with any
+//! further arguments passed through and `HOOKE_PYTHON` naming that environment's Python.
 //!
 //! Plain `std`, no dependencies: it builds in a second, before anything else.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
 /// A system requirement of the tests: what must exist, and the Debian package providing it.
@@ -37,13 +38,18 @@ const REQUIREMENTS: [Requirement; 4] = [
 ];
 
 const USAGE: &str = "usage: cargo xtask test [ARGS…]   set up what the tests need, then `cargo test --workspace ARGS…`
-       cargo xtask setup           only install the missing system packages";
+       cargo xtask setup           only install what the tests need";
+
+/// The Python packages of the export checks, pinned.
+const REQUIREMENTS_TXT: &str = "crates/hooke-cli/tests/python/requirements.txt";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
-        Some("test") => setup().and_then(|()| test(&args[1..])),
-        Some("setup") => setup().map(|()| ExitCode::SUCCESS),
+        Some("test") => setup()
+            .and_then(|()| python())
+            .and_then(|python| test(&args[1..], &python)),
+        Some("setup") => setup().and_then(|()| python()).map(|_| ExitCode::SUCCESS),
         Some("-h" | "--help") => {
             println!("{USAGE}");
             Ok(ExitCode::SUCCESS)
@@ -86,6 +92,11 @@ fn setup() -> Result<(), String> {
         "xtask: installing {} (Debian packages the viewer test needs)",
         missing.join(" ")
     );
+    apt_install(&missing).map_err(|e| format!("{e}; or set HOOKE_SKIP_VIEWER=1"))
+}
+
+/// Installs Debian `packages` with apt-get, through `sudo` when not root.
+fn apt_install(packages: &[&str]) -> Result<(), String> {
     let root = Command::new("id")
         .arg("-u")
         .output()
@@ -107,24 +118,110 @@ fn setup() -> Result<(), String> {
             Ok(())
         } else {
             Err(format!(
-                "apt-get {} failed ({status}); install {} yourself, or set HOOKE_SKIP_VIEWER=1",
+                "apt-get {} failed ({status}); install {} yourself",
                 args[0],
-                missing.join(" ")
+                packages.join(" ")
             ))
         }
     };
     apt(&["update", "-qq"])?;
     let mut install = vec!["install", "-y", "-qq"];
-    install.extend(&missing);
+    install.extend(packages);
     apt(&install)
 }
 
-/// `cargo test --workspace` with `args`, with this cargo.
-fn test(args: &[String]) -> Result<ExitCode, String> {
+/// The workspace root (this crate is `crates/xtask`).
+fn root() -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    root.canonicalize().unwrap_or(root)
+}
+
+/// Runs `program args`, failing with `what` when it does not succeed.
+fn run(program: &Path, args: &[&str], what: &str) -> Result<(), String> {
+    let status = Command::new(program)
+        .args(args)
+        .status()
+        .map_err(|e| format!("{what}: cannot run {}: {e}", program.display()))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{what}: {} {} failed ({status})",
+            program.display(),
+            args.join(" ")
+        ))
+    }
+}
+
+/// The Python of the virtual environment `target/python`, created and given the pinned
+/// packages of [`REQUIREMENTS_TXT`] unless it already has them.
+fn python() -> Result<PathBuf, String> {
+    let target =
+        std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root().join("target"), PathBuf::from);
+    let env = target.join("python");
+    let python = env.join("bin/python");
+    let requirements = root().join(REQUIREMENTS_TXT);
+    // A stamp of the requirements installed: pip is asked again only when they change.
+    let stamp = env.join("hooke-requirements.txt");
+    let wanted = std::fs::read_to_string(&requirements)
+        .map_err(|e| format!("cannot read {}: {e}", requirements.display()))?;
+    if python.exists() && std::fs::read_to_string(&stamp).is_ok_and(|s| s == wanted) {
+        return Ok(python);
+    }
+    if !python.exists() {
+        if !present("python3") {
+            return Err(
+                "the export checks need python3 (3.9 or newer): install it, or set \
+                        HOOKE_SKIP_PYTHON=1 and run cargo test --workspace"
+                    .into(),
+            );
+        }
+        eprintln!("xtask: creating the Python environment {}", env.display());
+        let env_text = env.to_string_lossy().into_owned();
+        if run(
+            Path::new("python3"),
+            &["-m", "venv", &env_text],
+            "python3 -m venv",
+        )
+        .is_err()
+        {
+            // Debian's Python keeps venv in a package of its own.
+            if present("apt-get") {
+                apt_install(&["python3-venv"])?;
+            }
+            run(
+                Path::new("python3"),
+                &["-m", "venv", &env_text],
+                "python3 -m venv",
+            )?;
+        }
+    }
+    eprintln!("xtask: installing the export checks' Python packages ({REQUIREMENTS_TXT})");
+    let requirements_text = requirements.to_string_lossy().into_owned();
+    run(
+        &python,
+        &[
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--disable-pip-version-check",
+            "-r",
+            &requirements_text,
+        ],
+        "pip install",
+    )?;
+    std::fs::write(&stamp, wanted).map_err(|e| format!("cannot write {}: {e}", stamp.display()))?;
+    Ok(python)
+}
+
+/// `cargo test --workspace` with `args`, with this cargo, and `python` as `HOOKE_PYTHON`.
+fn test(args: &[String], python: &Path) -> Result<ExitCode, String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let status = Command::new(cargo)
         .args(["test", "--workspace"])
         .args(args)
+        .env("HOOKE_PYTHON", python)
         .status()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
     Ok(match status.code() {

@@ -1,0 +1,273 @@
+//! `hooke run SCENE --export PATH`: a run's frames in the formats other tools render from,
+//! written as the run goes (memory does not grow with the frame count), each file whole or
+//! not at all, and complete up to the last frame when a run is interrupted or diverges.
+//!
+//! The format follows the path:
+//!
+//! * `NAME.usda`: one USD stage ([`usd`]), Y-up, metres, a time code per frame;
+//! * `NAME.pc2`: Blender's point cache for one body ([`pc2`]), with `NAME.obj`, the body's
+//!   mesh at the start, beside it;
+//! * `DIR/` with `--format ply` or `--format obj`: a file per frame, `DIR/frame-00000.ply`
+//!   … ([`ply`], [`obj`]).
+//!
+//! Coordinates are the simulation's: metres, +Y up.
+
+pub mod obj;
+pub mod pc2;
+pub mod ply;
+pub mod usd;
+
+use crate::output::{check_output_file, check_output_folder};
+use anyhow::{Result, bail};
+use hooke_core::Vec3;
+use hooke_scene::{Body, ColliderGeometry, Scene, Topology};
+use std::path::{Path, PathBuf};
+
+/// The format of a folder export (`--format`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FolderFormat {
+    /// Binary little-endian PLY: vertices with normals, triangles.
+    Ply,
+    /// Wavefront OBJ: bodies and colliders as named objects.
+    Obj,
+}
+
+impl FolderFormat {
+    /// The file extension.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Self::Ply => "ply",
+            Self::Obj => "obj",
+        }
+    }
+}
+
+/// Where a run is exported, decided from `--export PATH` before the scene is built.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Target {
+    /// A USD stage.
+    Usd(PathBuf),
+    /// A Blender point cache of one body (the named one, or the first), and its mesh.
+    Pc2 {
+        /// The `.pc2` file.
+        path: PathBuf,
+        /// The body's name, if one was asked for.
+        body: Option<String>,
+    },
+    /// A file per frame in a folder.
+    Folder {
+        /// The folder.
+        dir: PathBuf,
+        /// The files' format.
+        format: FolderFormat,
+    },
+}
+
+impl Target {
+    /// The target `--export path` names, with `--format` and `--body` if given; refused with
+    /// what was expected when the combination makes no sense or the path cannot be written.
+    ///
+    /// ```
+    /// use hooke_cli::export::{FolderFormat, Target};
+    /// use std::path::Path;
+    /// let dir = std::env::temp_dir();
+    /// let usd = dir.join("run.usda");
+    /// assert_eq!(Target::new(&usd, None, None).unwrap(), Target::Usd(usd.clone()));
+    /// let frames = format!("{}/frames/", dir.display());
+    /// assert!(matches!(
+    ///     Target::new(Path::new(&frames), Some(FolderFormat::Ply), None),
+    ///     Ok(Target::Folder { format: FolderFormat::Ply, .. })
+    /// ));
+    /// assert!(Target::new(Path::new(&frames), None, None).is_err()); // which format?
+    /// assert!(Target::new(&dir.join("run.fbx"), None, None).is_err());
+    /// ```
+    pub fn new(path: &Path, format: Option<FolderFormat>, body: Option<&str>) -> Result<Self> {
+        let text = path.to_string_lossy();
+        let folder =
+            text.ends_with('/') || text.ends_with(std::path::MAIN_SEPARATOR) || path.is_dir();
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        let target = match (folder, ext.as_str(), format) {
+            (true, _, Some(format)) => {
+                check_output_folder(path, "--export")?;
+                Target::Folder {
+                    dir: path.to_path_buf(),
+                    format,
+                }
+            }
+            (true, _, None) => bail!(
+                "--export {}: a folder export needs --format ply or --format obj",
+                path.display()
+            ),
+            (false, "usda" | "pc2", Some(format)) => bail!(
+                "--format {}: only folder exports (--export DIR/) take a format; {} is a .{ext} \
+                 file",
+                format.extension(),
+                path.display()
+            ),
+            (false, "usda", None) => {
+                check_output_file(path, "--export", &["usda"])?;
+                Target::Usd(path.to_path_buf())
+            }
+            (false, "pc2", None) => {
+                check_output_file(path, "--export", &["pc2"])?;
+                check_output_file(&path.with_extension("obj"), "--export (its mesh)", &["obj"])?;
+                Target::Pc2 {
+                    path: path.to_path_buf(),
+                    body: body.map(str::to_string),
+                }
+            }
+            _ => bail!(
+                "--export {}: expected a file ending in .usda or .pc2, or a folder ending in / \
+                 with --format ply or obj",
+                path.display()
+            ),
+        };
+        if body.is_some() && !matches!(target, Target::Pc2 { .. }) {
+            bail!("--body: only a .pc2 export holds one body; the others hold them all");
+        }
+        Ok(target)
+    }
+}
+
+/// An export being written.
+pub enum Exporter {
+    /// A USD stage.
+    Usd(usd::UsdExport),
+    /// A point cache.
+    Pc2(pc2::Pc2Export),
+    /// OBJ frames.
+    Obj(obj::ObjExport),
+    /// PLY frames.
+    Ply(ply::PlyExport),
+}
+
+impl Exporter {
+    /// Starts exporting `scene` to `target`.
+    pub fn create(target: &Target, scene: &Scene) -> Result<Self> {
+        Ok(match target {
+            Target::Usd(path) => Self::Usd(usd::UsdExport::create(path, scene)?),
+            Target::Pc2 { path, body } => {
+                Self::Pc2(pc2::Pc2Export::create(path, body.as_deref(), scene)?)
+            }
+            Target::Folder {
+                dir,
+                format: FolderFormat::Obj,
+            } => Self::Obj(obj::ObjExport::new(dir, scene)?),
+            Target::Folder {
+                dir,
+                format: FolderFormat::Ply,
+            } => Self::Ply(ply::PlyExport::new(dir, scene)?),
+        })
+    }
+
+    /// Writes frame `frame`: `scene` at its current state.
+    pub fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
+        match self {
+            Self::Usd(e) => e.frame(frame, scene),
+            Self::Pc2(e) => e.frame(frame, scene),
+            Self::Obj(e) => e.frame(frame, scene),
+            Self::Ply(e) => e.frame(frame, scene),
+        }
+    }
+
+    /// Finishes the files with the frames written so far, and says what was written.
+    pub fn finish(self) -> Result<String> {
+        match self {
+            Self::Usd(e) => e.finish(),
+            Self::Pc2(e) => e.finish(),
+            Self::Obj(e) => Ok(e.summary()),
+            Self::Ply(e) => Ok(e.summary()),
+        }
+    }
+}
+
+/// What a body becomes outside Hooke.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape<'a> {
+    /// A triangle mesh: its triangles as simulation particle indices.
+    Mesh(&'a [[u32; 3]]),
+    /// A polyline through its particles in order (a chain).
+    Curve,
+    /// Loose points.
+    Points,
+}
+
+/// The shape `body` is exported as.
+pub fn shape(body: &Body) -> Shape<'_> {
+    if !body.triangles.is_empty() {
+        Shape::Mesh(&body.triangles)
+    } else if body.topology == Topology::Chain {
+        Shape::Curve
+    } else {
+        Shape::Points
+    }
+}
+
+/// Half the side of the exported ground square, metres: larger than any built-in scene's
+/// reach.
+const GROUND_HALF: f64 = 2.5;
+
+/// Each collider's name (`<index>-<kind>`) and surface as triangles, which do not move: the
+/// analytic cylinder tessellated inside the true solid, the ground a square around the
+/// bodies' start, an inclined plane clipped to the jello box or a region around the bodies.
+pub fn collider_triangles(scene: &Scene) -> Vec<(String, Vec<[Vec3; 3]>)> {
+    let x = &scene.simulation.particles().x;
+    let (lo, hi) = x.iter().fold(
+        (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+    );
+    let centre = if x.is_empty() {
+        Vec3::zeros()
+    } else {
+        (lo + hi) * 0.5
+    };
+    let region = scene
+        .colliders
+        .iter()
+        .find_map(|c| match c {
+            ColliderGeometry::Box(b) => Some((b.min, b.max)),
+            _ => None,
+        })
+        .unwrap_or((
+            centre.add_scalar(-GROUND_HALF),
+            centre.add_scalar(GROUND_HALF),
+        ));
+    scene
+        .colliders
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            (
+                format!("{k}-{}", c.kind()),
+                c.triangles(centre, GROUND_HALF, region),
+            )
+        })
+        .collect()
+}
+
+/// Unit vertex normals of `triangles` (indices into `x`): each vertex's sum of its
+/// triangles' area-weighted normals, normalised; zero for vertices on no triangle or only on
+/// degenerate ones.
+pub fn vertex_normals(x: &[Vec3], triangles: &[[u32; 3]], out: &mut Vec<Vec3>) {
+    out.clear();
+    out.resize(x.len(), Vec3::zeros());
+    for t in triangles {
+        let [a, b, c] = t.map(|i| i as usize);
+        let n = (x[b] - x[a]).cross(&(x[c] - x[a]));
+        for i in [a, b, c] {
+            out[i] += n;
+        }
+    }
+    for n in out.iter_mut() {
+        let len = n.norm();
+        *n = if len > 0.0 { *n / len } else { Vec3::zeros() };
+    }
+}
+
+/// `x` as the nearest `f32`, as the exported formats store it.
+pub fn f32s(x: &Vec3) -> [f32; 3] {
+    [x.x as f32, x.y as f32, x.z as f32]
+}

@@ -1,0 +1,146 @@
+//! `--export NAME.pc2`: Blender's point cache (the format of its Mesh Cache modifier) for
+//! one body, and `NAME.obj`, that body's mesh at the start, beside it, so that the cloth
+//! comes into Blender without a plug-in: import the OBJ, add a Mesh Cache modifier, pick the
+//! PC2.
+//!
+//! The format, all little-endian: a 32-byte header — the 12 bytes `POINTCACHE2\0`, `i32`
+//! version 1, `i32` point count, `f32` start frame, `f32` sampling (frames per sample),
+//! `i32` sample count — then per sample the points as `f32` triples. Sample `k` is frame `k`
+//! of the run (start frame 0, sampling 1). The points are the body's particles in order (the
+//! OBJ's vertices), in metres, +Y up. Blender's OBJ importer turns +Y up into its +Z up on
+//! the object, and the cache, read with the modifier's default axes, follows the object;
+//! Blender's Mesh Cache modifier ignores the header's start frame and puts sample 0 at its
+//! own Frame Start (0 by default, while a timeline starts at 1).
+//!
+//! Samples are appended as the run goes; the count in the header is written when the run
+//! ends, at the last complete frame.
+
+use crate::output::AtomicFile;
+use anyhow::{Context, Result, bail};
+use hooke_scene::{Body, Scene};
+use std::io::{Seek, SeekFrom, Write};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+/// The header's first 12 bytes.
+pub const MAGIC: &[u8; 12] = b"POINTCACHE2\0";
+/// Where the sample count sits in the header.
+const COUNT_OFFSET: u64 = 28;
+/// The header's length in bytes.
+pub const HEADER_BYTES: u64 = 32;
+
+/// A point cache being written.
+pub struct Pc2Export {
+    path: PathBuf,
+    file: AtomicFile,
+    body: String,
+    range: Range<usize>,
+    samples: u32,
+}
+
+/// The body a cache holds: the one named, or the first.
+fn pick<'a>(scene: &'a Scene, name: Option<&str>) -> Result<&'a Body> {
+    match name {
+        None => match scene.bodies.first() {
+            Some(b) => Ok(b),
+            None => bail!("--export: scene {} has no body to cache", scene.spec.name),
+        },
+        Some(name) => match scene.bodies.iter().find(|b| b.name == name) {
+            Some(b) => Ok(b),
+            None => {
+                let names: Vec<&str> = scene.bodies.iter().map(|b| b.name.as_str()).collect();
+                bail!(
+                    "--body {name}: scene {} has no such body; it has {}",
+                    scene.spec.name,
+                    names.join(", ")
+                )
+            }
+        },
+    }
+}
+
+impl Pc2Export {
+    /// Starts the cache `path` of body `body` (or the first) of `scene`, and writes the
+    /// body's mesh as it is now to the `.obj` beside it.
+    pub fn create(path: &Path, body: Option<&str>, scene: &Scene) -> Result<Self> {
+        let body = pick(scene, body)?;
+        let points = u32::try_from(body.range.len())
+            .ok()
+            .filter(|&n| n <= i32::MAX as u32)
+            .with_context(|| format!("--export: body {} is too large for a PC2", body.name))?;
+        let mesh = path.with_extension("obj");
+        let mut obj = AtomicFile::create(&mesh)?;
+        let sim = &scene.simulation;
+        let x = &sim.particles().x;
+        let springs = &sim.model().springs;
+        (|| -> std::io::Result<()> {
+            let w = obj.writer();
+            writeln!(
+                w,
+                "# hooke: scene {}, body {} at the start (the mesh of {}), metres, +Y up",
+                scene.spec.name,
+                body.name,
+                path.file_name().unwrap_or_default().to_string_lossy()
+            )?;
+            super::obj::write_body(w, body, x, springs, 1)
+        })()
+        .with_context(|| format!("cannot write {}", mesh.display()))?;
+        obj.commit()?;
+        let mut file = AtomicFile::create(path)?;
+        let w = file.writer();
+        let header = (|| -> std::io::Result<()> {
+            w.write_all(MAGIC)?;
+            w.write_all(&1i32.to_le_bytes())?;
+            w.write_all(&(points as i32).to_le_bytes())?;
+            w.write_all(&0f32.to_le_bytes())?;
+            w.write_all(&1f32.to_le_bytes())?;
+            w.write_all(&0i32.to_le_bytes())
+        })();
+        header.with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            file,
+            body: body.name.clone(),
+            range: body.range.clone(),
+            samples: 0,
+        })
+    }
+
+    /// Appends frame `frame` of `scene` as the next sample.
+    pub fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
+        debug_assert_eq!(frame, u64::from(self.samples));
+        let x = &scene.simulation.particles().x[self.range.clone()];
+        let w = self.file.writer();
+        let mut bytes = [0u8; 12];
+        for p in x {
+            for (k, c) in super::f32s(p).iter().enumerate() {
+                bytes[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
+            }
+            w.write_all(&bytes)
+                .with_context(|| format!("cannot write {}", self.path.display()))?;
+        }
+        self.samples += 1;
+        Ok(())
+    }
+
+    /// Writes the sample count and puts the cache in place.
+    pub fn finish(mut self) -> Result<String> {
+        let samples = self.samples as i32;
+        let w = self.file.writer();
+        (|| -> std::io::Result<()> {
+            w.seek(SeekFrom::Start(COUNT_OFFSET))?;
+            w.write_all(&samples.to_le_bytes())
+        })()
+        .with_context(|| format!("cannot write {}", self.path.display()))?;
+        self.file.commit()?;
+        Ok(format!(
+            "{} ({} sample{} of body {}, {} points) and its mesh {}",
+            self.path.display(),
+            samples,
+            if samples == 1 { "" } else { "s" },
+            self.body,
+            self.range.len(),
+            self.path.with_extension("obj").display()
+        ))
+    }
+}
