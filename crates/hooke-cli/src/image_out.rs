@@ -77,7 +77,48 @@ fn parse_zoom(s: &str) -> Result<f64, String> {
     parse_within(s, 1e-3, 1e3, "a zoom factor")
 }
 
+/// `x` within `[lo, hi]` for option `what`, or the command line's message.
+fn within(x: f64, lo: f64, hi: f64, what: &str) -> Result<f64> {
+    parse_within(&x.to_string(), lo, hi, what).map_err(anyhow::Error::msg)
+}
+
 impl View {
+    /// A view from values given in code (the Python package's `render`), checked as the
+    /// command line checks its options: size 8 to 8192 each way, style `solid`, `springs`
+    /// or `both`, yaw within ±3600°, pitch within ±89°, zoom 0.001 to 1000, supersample 1
+    /// to 4.
+    ///
+    /// ```
+    /// use hooke_cli::image_out::View;
+    /// assert!(View::checked((320, 240), "solid", (30.0, 22.0), 1.0, 2).is_ok());
+    /// assert!(View::checked((320, 240), "solid", (30.0, 95.0), 1.0, 2).is_err());
+    /// assert!(View::checked((320, 240), "wire", (30.0, 22.0), 1.0, 2).is_err());
+    /// ```
+    pub fn checked(
+        (width, height): (u32, u32),
+        style: &str,
+        (yaw, pitch): (f64, f64),
+        zoom: f64,
+        supersample: u32,
+    ) -> Result<Self> {
+        let size =
+            parse_size(&format!("{width}x{height}")).map_err(|e| anyhow::anyhow!("size: {e}"))?;
+        let style = <Style as clap::ValueEnum>::from_str(style, true).map_err(|_| {
+            anyhow::anyhow!("style: expected solid, springs or both, found '{style}'")
+        })?;
+        if !(1..=4).contains(&supersample) {
+            anyhow::bail!("supersample: expected 1 to 4, found {supersample}");
+        }
+        Ok(Self {
+            size,
+            style,
+            yaw: within(yaw, -3600.0, 3600.0, "an angle in degrees").context("yaw")?,
+            pitch: within(pitch, -89.0, 89.0, "an elevation in degrees").context("pitch")?,
+            zoom: within(zoom, 1e-3, 1e3, "a zoom factor").context("zoom")?,
+            supersample,
+        })
+    }
+
     /// The camera for the scene's current state.
     pub fn camera(&self, scene: &Scene) -> Camera {
         let mut camera = frame_camera(scene, self.yaw, self.pitch);

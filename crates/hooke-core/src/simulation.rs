@@ -38,6 +38,10 @@ pub struct Simulation {
     contacts: ContactState,
     /// The last step's report (before the first step: nothing saved, nothing checked).
     last: StepReport,
+    /// Whether every loop of a step runs inline (a system of a few particles): a step then
+    /// stays on the calling thread instead of hopping onto a pool worker, which would cost
+    /// more than the step.
+    inline: bool,
 }
 
 impl Simulation {
@@ -55,6 +59,10 @@ impl Simulation {
         let mut workspace = Workspace::default();
         workspace.ensure(&model, particles.len());
         let contacts = ContactState::new(particles.len());
+        let inline = particles.len() <= crate::assembly::REDUCE_BLOCK
+            // One partition of springs (see `partition_size`).
+            && model.springs.len() <= crate::assembly::PARTITION_MIN / 4
+            && !model.surfaces.iter().any(crate::surface::Surface::is_active);
         Self {
             particles,
             model,
@@ -67,6 +75,7 @@ impl Simulation {
                 saved_start: false,
                 verdict: None,
             },
+            inline,
         }
     }
 
@@ -142,6 +151,9 @@ impl Simulation {
     /// Advances one step: the integrator, then the contact phase (collision responses,
     /// feature and self contacts, see [`crate::contact`]), then the divergence check.
     pub fn step(&mut self) -> Result<(), Divergence> {
+        if self.inline {
+            return self.step_here();
+        }
         parallel::on_worker(|| self.step_here())
     }
 

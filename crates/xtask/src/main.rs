@@ -1,8 +1,10 @@
 //! `cargo xtask test`: the README's test command. It installs what the tests need when it is
 //! missing — the viewer test's X server, key sender and X libraries as Debian packages
-//! through `apt-get`; the export checks' Python packages (`usd-core`, `numpy`) into a
-//! virtual environment, `target/python` — then runs `cargo test --workspace` with any
-//! further arguments passed through and `HOOKE_PYTHON` naming that environment's Python.
+//! through `apt-get`; the pinned Python packages of `python/requirements-test.txt` into a
+//! virtual environment, `target/python` — builds and installs the `hooke` Python package
+//! there, runs `cargo test --workspace` with any further arguments passed through and
+//! `HOOKE_PYTHON` naming that environment's Python, then the Python package's tests with
+//! pytest.
 //!
 //! Plain `std`, no dependencies: it builds in a second, before anything else.
 
@@ -40,8 +42,8 @@ const REQUIREMENTS: [Requirement; 4] = [
 const USAGE: &str = "usage: cargo xtask test [ARGS…]   set up what the tests need, then `cargo test --workspace ARGS…`
        cargo xtask setup           only install what the tests need";
 
-/// The Python packages of the export checks, pinned.
-const REQUIREMENTS_TXT: &str = "crates/hooke-cli/tests/python/requirements.txt";
+/// The Python packages the tests need, pinned.
+const REQUIREMENTS_TXT: &str = "python/requirements-test.txt";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -215,8 +217,49 @@ fn python() -> Result<PathBuf, String> {
     Ok(python)
 }
 
-/// `cargo test --workspace` with `args`, with this cargo, and `python` as `HOOKE_PYTHON`.
+/// Builds the `hooke` Python package (`python/`, maturin) and installs it into the
+/// environment of `python`, whose `bin` holds maturin.
+fn install_package(python: &Path) -> Result<(), String> {
+    eprintln!("xtask: building and installing the hooke Python package (python/)");
+    let bin = python.parent().unwrap_or(Path::new("."));
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    let path = std::env::join_paths(
+        std::iter::once(bin.to_path_buf()).chain(std::env::split_paths(&path)),
+    )
+    .map_err(|e| format!("PATH: {e}"))?;
+    let status = Command::new(python)
+        .args([
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--disable-pip-version-check",
+        ])
+        .args(["--no-build-isolation", "--force-reinstall", "--no-deps"])
+        .arg(root().join("python"))
+        .env("PATH", path)
+        .status()
+        .map_err(|e| format!("cannot run pip: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("pip install ./python failed ({status})"))
+    }
+}
+
+/// The exit code of a finished command.
+fn code(status: std::process::ExitStatus) -> ExitCode {
+    match status.code() {
+        Some(0) => ExitCode::SUCCESS,
+        Some(code) => ExitCode::from(u8::try_from(code).unwrap_or(1)),
+        None => ExitCode::FAILURE,
+    }
+}
+
+/// `cargo test --workspace` with `args`, with this cargo and `python` as `HOOKE_PYTHON`;
+/// then, when no arguments narrowed the run, the Python package's tests with pytest.
 fn test(args: &[String], python: &Path) -> Result<ExitCode, String> {
+    install_package(python)?;
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let status = Command::new(cargo)
         .args(["test", "--workspace"])
@@ -224,9 +267,24 @@ fn test(args: &[String], python: &Path) -> Result<ExitCode, String> {
         .env("HOOKE_PYTHON", python)
         .status()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
-    Ok(match status.code() {
-        Some(0) => ExitCode::SUCCESS,
-        Some(code) => ExitCode::from(u8::try_from(code).unwrap_or(1)),
-        None => ExitCode::FAILURE,
-    })
+    if !status.success() {
+        return Ok(code(status));
+    }
+    if !args.is_empty() {
+        eprintln!(
+            "xtask: arguments given, so python/tests did not run (run them with no arguments)"
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    // The command the bit-for-bit tests compare with: the one cargo test just built.
+    let target =
+        std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root().join("target"), PathBuf::from);
+    let status = Command::new(python)
+        .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
+        .arg(root().join("python/tests"))
+        .env("HOOKE_BIN", target.join("debug/hooke"))
+        .current_dir(root())
+        .status()
+        .map_err(|e| format!("cannot run pytest: {e}"))?;
+    Ok(code(status))
 }

@@ -1,0 +1,216 @@
+"""The `hooke` Python package as a notebook user drives it: same bits as the command, numpy
+arrays, errors with their file and line, renders, exports, Ctrl-C, the GIL released while
+stepping, and sweeps whose results do not depend on where they ran (serial, a process
+pool, a local Ray cluster).
+
+Needs the `hooke` command for the bit-for-bit comparison: `HOOKE_BIN`, as `cargo xtask test`
+sets it, or `hooke` on the PATH.
+"""
+
+import csv
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import hooke
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def hooke_bin():
+    path = os.environ.get("HOOKE_BIN") or shutil.which("hooke")
+    assert path, "set HOOKE_BIN to the hooke command (cargo xtask test does) or put it on PATH"
+    return path
+
+
+def cli_trajectory(tmp_path, *args):
+    """`hooke run ARGS --trajectory t.csv`: positions and velocities per frame."""
+    out = tmp_path / "t.csv"
+    subprocess.run([hooke_bin(), "run", *args, "--trajectory", str(out)], check=True,
+                   capture_output=True)
+    frames = {}
+    with open(out, newline="") as f:
+        for r in csv.DictReader(f):
+            frames.setdefault(int(r["frame"]), []).append(
+                [float(r[k]) for k in ("x", "y", "z", "vx", "vy", "vz")])
+    return [np.array(frames[k]) for k in sorted(frames)]
+
+
+@pytest.mark.parametrize("source, steps, every", [
+    ("chain", 2000, 100),
+    ("cloth-table", 1200, 40),            # contacts: sticking to the mesh table
+    ("assets/worlds/rotate.w", 300, 10),  # rk4, force field, penalty colliders
+    ("flag", 800, 40),                    # air
+])
+def test_a_trajectory_stepped_from_python_is_the_commands_bit_for_bit(tmp_path, source, steps, every):
+    path = str(ROOT / source) if source.endswith(".w") else source
+    frames = cli_trajectory(tmp_path, path, "--steps", str(steps), "--every", str(every))
+    sim = hooke.load(path, steps=steps, every=every)
+    for k, expected in enumerate(frames):
+        if k > 0:
+            sim.step(every)
+        got = np.hstack([sim.positions, sim.velocities])
+        # The CSV holds each number's shortest round-trip digits: equal means same bits.
+        assert np.array_equal(got, expected), f"{source}: frame {k} differs"
+    assert sim.steps_taken == steps
+
+
+def test_arrays_have_the_documented_shapes_and_cannot_be_written():
+    sim = hooke.load("hanging-cloth")
+    x, v, m, springs = sim.positions, sim.velocities, sim.masses, sim.springs
+    assert x.shape == v.shape == (625, 3) and x.dtype == np.float64
+    assert m.shape == (625,) and abs(m.sum() - 0.5) < 1e-12
+    assert springs.shape == (len(springs), 2) and springs.dtype == np.int64
+    assert springs.min() >= 0 and springs.max() < 625
+    assert sim.pinned.sum() == 2
+    assert sim.bodies == [("cloth", 0, 625)]
+    with pytest.raises(ValueError):
+        x[0, 0] = 1.0
+    # A copy of the state at the time it was taken.
+    before = sim.positions
+    sim.step(100)
+    assert not np.array_equal(before, sim.positions)
+    assert sim.time == pytest.approx(100 * sim.dt)
+
+
+def test_advance_takes_the_nearest_whole_number_of_steps():
+    sim = hooke.load("chain")
+    sim.advance(10.4 * sim.dt)
+    assert sim.steps_taken == 10
+    sim.run()
+    assert sim.steps_taken == sim.total_steps
+    with pytest.raises(ValueError):
+        sim.advance(-1.0)
+
+
+def test_bad_input_raises_with_the_file_line_or_key(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('name = "x"\n[simulation]\nintegrator = "rk5"\ndt = 0.001\nsteps = 10\nevery = 1\n')
+    with pytest.raises(hooke.HookeError, match=r"bad.toml: line 3, column 14: unknown integrator 'rk5'"):
+        hooke.load(str(bad))
+    with pytest.raises(hooke.HookeError, match="no built-in scene 'nope'"):
+        hooke.load("nope")
+    with pytest.raises(hooke.HookeError, match="dt: expected a finite number of seconds > 0"):
+        hooke.load("chain", dt=-1.0)
+    with pytest.raises(hooke.HookeError, match="springz"):
+        hooke.load("hanging-cloth", set={"body.springz.ks": 1.0})
+    with pytest.raises(hooke.HookeError, match="--table nope.obj: no such file"):
+        hooke.load("cloth-table", table="nope.obj")
+    with pytest.raises(TypeError):
+        hooke.load("chain", stiffness=3)
+    with pytest.raises(hooke.DivergenceError, match=r"diverged at step \d+ .* use dt = "):
+        hooke.load("chain", dt=10.0).advance(100.0)
+
+
+def test_scene_keys_change_the_physics():
+    soft = hooke.load("hanging-cloth", duration=1.0, set={"body.springs.structural.ks": 40.0})
+    stiff = hooke.load("hanging-cloth", duration=1.0)
+    soft.run()
+    stiff.run()
+    # A tenth of the stiffness: the cloth hangs lower (1.504 m against 1.530 m on average).
+    assert hooke.metrics.mean_height(soft) < hooke.metrics.mean_height(stiff) - 0.01
+
+
+def test_render_gives_an_rgb_picture_of_the_asked_size():
+    sim = hooke.load("jello-cube")
+    img = sim.render(width=160, height=120, style="both", supersample=1)
+    assert img.shape == (120, 160, 3) and img.dtype == np.uint8
+    assert img.std() > 10, "a picture, not a blank"
+    with pytest.raises(hooke.HookeError, match="style"):
+        sim.render(style="wire")
+    with pytest.raises(hooke.HookeError, match="pitch"):
+        sim.render(pitch=90.0)
+
+
+def test_export_writes_what_the_command_writes(tmp_path):
+    import pxr.Usd  # usd-core: cargo xtask test installs it
+    sim = hooke.load("chain", steps=400, every=40)
+    said = sim.export(str(tmp_path / "c.usda"))
+    assert "11 frames" in said
+    stage = pxr.Usd.Stage.Open(str(tmp_path / "c.usda"))
+    assert stage.GetEndTimeCode() == 10
+    assert sim.steps_taken == 400
+    with pytest.raises(hooke.HookeError, match="a folder export needs --format"):
+        sim.export(str(tmp_path) + "/")
+
+
+def test_stepping_releases_the_gil():
+    sim = hooke.load("cloth-table")
+    ticks = 0
+    done = threading.Event()
+
+    def tick():
+        nonlocal ticks
+        while not done.is_set():
+            ticks += 1
+
+    t = threading.Thread(target=tick)
+    t.start()
+    started = time.perf_counter()
+    sim.advance(0.5)
+    elapsed = time.perf_counter() - started
+    done.set()
+    t.join()
+    # With the GIL held for the whole advance the other thread would count only at the
+    # interpreter's switch points around the call; released, it counts all along.
+    assert elapsed > 0.05 and ticks > 10_000, (elapsed, ticks)
+
+
+def test_ctrl_c_interrupts_a_long_advance_after_a_whole_step():
+    sim = hooke.load("cloth-table")
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    started = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        sim.advance(1000.0)
+    assert time.perf_counter() - started < 5.0
+    assert 0 < sim.steps_taken < 1000.0 / sim.dt
+    assert sim.time == sim.steps_taken * sim.dt
+
+
+lowest_point = hooke.metrics.lowest_point
+
+GRID = {
+    "body.springs.structural.ks": [150.0, 600.0],
+    "table": ["builtin:table.obj", "builtin:square-table.obj"],
+}
+
+
+def test_a_sweep_gives_one_row_per_point_the_same_serially_and_in_processes():
+    serial = hooke.sweep("cloth-table", GRID, lowest_point, executor="serial", duration=1.0)
+    assert [(r["body.springs.structural.ks"], r["table"]) for r in serial] == [
+        (150.0, "builtin:table.obj"), (150.0, "builtin:square-table.obj"),
+        (600.0, "builtin:table.obj"), (600.0, "builtin:square-table.obj"),
+    ]
+    assert len({r["metric"] for r in serial}) == 4, "every point a different run"
+    pooled = hooke.sweep("cloth-table", GRID, lowest_point, max_workers=2, duration=1.0)
+    assert pooled == serial
+
+
+def test_a_sweep_on_a_local_ray_cluster_equals_the_same_points_run_serially():
+    import ray  # cargo xtask test installs it
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        on_ray = hooke.sweep("cloth-table", GRID, lowest_point, executor="ray", duration=1.0)
+    finally:
+        ray.shutdown()
+    serial = hooke.sweep("cloth-table", GRID, lowest_point, executor="serial", duration=1.0)
+    assert on_ray == serial
+
+
+def test_the_ray_example_runs_and_plots(tmp_path):
+    out = tmp_path / "sweep.png"
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "examples/sweep_ray.py"), "--quick", "--out", str(out)],
+        capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert out.stat().st_size > 10_000
+    assert "round" in result.stdout and "square" in result.stdout
