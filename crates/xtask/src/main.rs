@@ -173,7 +173,7 @@ fn python() -> Result<PathBuf, String> {
     if !python.exists() {
         if !present("python3") {
             return Err(
-                "the export checks need python3 (3.9 or newer): install it, or set \
+                "the Python tests and export checks need python3 (3.9 or newer): install it, or set \
                         HOOKE_SKIP_PYTHON=1 and run cargo test --workspace"
                     .into(),
             );
@@ -198,7 +198,7 @@ fn python() -> Result<PathBuf, String> {
             )?;
         }
     }
-    eprintln!("xtask: installing the export checks' Python packages ({REQUIREMENTS_TXT})");
+    eprintln!("xtask: installing the tests' Python packages ({REQUIREMENTS_TXT})");
     let requirements_text = requirements.to_string_lossy().into_owned();
     run(
         &python,

@@ -184,6 +184,21 @@ impl Exporter {
     }
 }
 
+/// Prepares `dir` for a folder export's `frame-NNNNN.ext` files (see
+/// [`crate::output::prepare_frame_folder`]), saying how many frames of an earlier run it
+/// removed.
+fn frame_folder(dir: &Path, ext: &str) -> Result<()> {
+    let removed = crate::output::prepare_frame_folder(dir, "--export", ext)?;
+    if removed > 0 {
+        eprintln!(
+            "--export: removed {removed} frame{} of an earlier run from {}",
+            if removed == 1 { "" } else { "s" },
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
 /// What a body becomes outside Hooke.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Shape<'a> {

@@ -29,14 +29,7 @@ impl ObjExport {
     /// Prepares the folder `dir` (created if missing; refused if it is a file) for `scene`,
     /// whose collider surfaces are computed here once.
     pub fn new(dir: &Path, scene: &Scene) -> Result<Self> {
-        let removed = crate::output::prepare_frame_folder(dir, "--export", "obj")?;
-        if removed > 0 {
-            eprintln!(
-                "--export: removed {removed} frame{} of an earlier run from {}",
-                if removed == 1 { "" } else { "s" },
-                dir.display()
-            );
-        }
+        super::frame_folder(dir, "obj")?;
         let colliders = super::collider_triangles(scene)
             .into_iter()
             .map(|(name, triangles)| (format!("collider:{name}"), triangles))

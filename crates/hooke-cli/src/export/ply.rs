@@ -97,14 +97,7 @@ impl PlyExport {
     /// Prepares the folder `dir` (created if missing; refused if it is a file, cleared of
     /// an earlier run's frames) for `scene`.
     pub fn new(dir: &Path, scene: &Scene) -> Result<Self> {
-        let removed = crate::output::prepare_frame_folder(dir, "--export", "ply")?;
-        if removed > 0 {
-            eprintln!(
-                "--export: removed {removed} frame{} of an earlier run from {}",
-                if removed == 1 { "" } else { "s" },
-                dir.display()
-            );
-        }
+        super::frame_folder(dir, "ply")?;
         let triangles: Vec<[u32; 3]> = scene
             .bodies
             .iter()

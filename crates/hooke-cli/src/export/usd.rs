@@ -144,7 +144,7 @@ impl UsdExport {
                     if k > 0 {
                         w.write_all(b", ")?;
                     }
-                    w.write_all(tuple(v).as_bytes())?;
+                    write!(w, "({}, {}, {})", F(v[0]), F(v[1]), F(v[2]))?;
                 }
                 w.write_all(b"],\n")
             };
