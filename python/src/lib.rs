@@ -153,6 +153,14 @@ impl Simulation {
             )));
         }
         let steps = driver::steps_for(&self.scene, seconds);
+        if steps as f64 > driver::MAX_STILL_STEPS {
+            return Err(PyValueError::new_err(format!(
+                "advance: {seconds} s is {steps:.1e} steps of dt = {} s, more than the {:.0e} a \
+                 call may take",
+                self.scene.simulation.dt(),
+                driver::MAX_STILL_STEPS
+            )));
+        }
         self.run_steps(py, steps)
     }
 

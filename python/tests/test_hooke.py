@@ -89,6 +89,8 @@ def test_advance_takes_the_nearest_whole_number_of_steps():
     assert sim.steps_taken == sim.total_steps
     with pytest.raises(ValueError):
         sim.advance(-1.0)
+    with pytest.raises(ValueError, match="more than the 1e12 a call may take"):
+        sim.advance(1e300)
 
 
 def test_bad_input_raises_with_the_file_line_or_key(tmp_path):
