@@ -171,6 +171,10 @@ fn python() -> Result<PathBuf, String> {
         return Ok(python);
     }
     if !python.exists() {
+        if !present("python3") && present("apt-get") {
+            eprintln!("xtask: installing python3 (Debian packages the Python tests need)");
+            apt_install(&["python3", "python3-venv"])?;
+        }
         if !present("python3") {
             return Err(
                 "the Python tests and export checks need python3 (3.9 or newer): install it, or set \
