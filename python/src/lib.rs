@@ -8,7 +8,7 @@
 use hooke_cli::export::{Exporter, FolderFormat, Target};
 use hooke_cli::image_out::View;
 use hooke_cli::{driver, source};
-use hooke_core::{Divergence, Integrator};
+use hooke_core::{Divergence, Integrator, Vec3};
 use hooke_scene::{Overrides, Scene};
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::create_exception;
@@ -103,10 +103,10 @@ impl Simulation {
         Ok(())
     }
 
-    /// A numpy array of shape `(rows, 3)` holding `values`, read-only.
-    fn matrix<'py>(py: Python<'py>, values: Vec<f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let rows = values.len() / 3;
-        let array = PyArray1::from_vec(py, values).reshape([rows, 3])?;
+    /// A read-only numpy array of shape `(N, 3)` holding the vectors `v`.
+    fn matrix<'py>(py: Python<'py>, v: &[Vec3]) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let values: Vec<f64> = v.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
+        let array = PyArray1::from_vec(py, values).reshape([v.len(), 3])?;
         read_only(array.as_any())?;
         Ok(array)
     }
@@ -212,15 +212,13 @@ impl Simulation {
     /// Positions in metres, an `(N, 3)` float64 array: a read-only copy of the state now.
     #[getter]
     fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let x = &self.scene.simulation.particles().x;
-        Self::matrix(py, x.iter().flat_map(|p| [p.x, p.y, p.z]).collect())
+        Self::matrix(py, &self.scene.simulation.particles().x)
     }
 
     /// Velocities in m/s, an `(N, 3)` float64 array: a read-only copy of the state now.
     #[getter]
     fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let v = &self.scene.simulation.particles().v;
-        Self::matrix(py, v.iter().flat_map(|p| [p.x, p.y, p.z]).collect())
+        Self::matrix(py, &self.scene.simulation.particles().v)
     }
 
     /// Masses in kg, an `(N,)` float64 array (read-only).

@@ -33,12 +33,22 @@ pub struct View {
     pub supersample: u32,
 }
 
+/// Image sides in pixels.
+const SIDE: std::ops::RangeInclusive<u32> = 8..=8192;
+/// Camera rotation about the vertical, degrees.
+const YAW: (f64, f64) = (-3600.0, 3600.0);
+/// Camera elevation, degrees: at ±90° the view direction is the up vector and the camera
+/// has no orientation.
+const PITCH: (f64, f64) = (-89.0, 89.0);
+/// Factor on the framing distance.
+const ZOOM: (f64, f64) = (1e-3, 1e3);
+
 /// Parses `WIDTHxHEIGHT`, each from 8 to 8192 pixels.
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once('x')
         .ok_or_else(|| format!("expected WIDTHxHEIGHT such as 800x600, found '{s}'"))?;
-    let parse = |v: &str| v.parse::<u32>().ok().filter(|n| (8..=8192).contains(n));
+    let parse = |v: &str| v.parse::<u32>().ok().filter(|n| SIDE.contains(n));
     match (parse(w), parse(h)) {
         (Some(w), Some(h)) => Ok((w, h)),
         _ => Err(format!(
@@ -53,11 +63,17 @@ pub fn parse_within(s: &str, lo: f64, hi: f64, what: &str) -> Result<f64, String
         .trim()
         .parse()
         .map_err(|_| format!("expected {what}, found '{s}'"))?;
+    in_range(x, (lo, hi), what, s)
+}
+
+/// `x` when it is finite and within `[lo, hi]`; otherwise what `what` expects, with `x`
+/// shown as `shown` (the text given on a command line).
+fn in_range(x: f64, (lo, hi): (f64, f64), what: &str, shown: &str) -> Result<f64, String> {
     if x.is_finite() && (lo..=hi).contains(&x) {
         Ok(x)
     } else {
         Err(format!(
-            "expected {what} from {} to {}, found {s}",
+            "expected {what} from {} to {}, found {shown}",
             hooke_core::Num(lo),
             hooke_core::Num(hi)
         ))
@@ -65,21 +81,21 @@ pub fn parse_within(s: &str, lo: f64, hi: f64, what: &str) -> Result<f64, String
 }
 
 fn parse_angle(s: &str) -> Result<f64, String> {
-    parse_within(s, -3600.0, 3600.0, "an angle in degrees")
+    parse_within(s, YAW.0, YAW.1, "an angle in degrees")
 }
 
 fn parse_pitch(s: &str) -> Result<f64, String> {
-    // At ±90° the view direction is the up vector and the camera has no orientation.
-    parse_within(s, -89.0, 89.0, "an elevation in degrees")
+    parse_within(s, PITCH.0, PITCH.1, "an elevation in degrees")
 }
 
 fn parse_zoom(s: &str) -> Result<f64, String> {
-    parse_within(s, 1e-3, 1e3, "a zoom factor")
+    parse_within(s, ZOOM.0, ZOOM.1, "a zoom factor")
 }
 
-/// `x` within `[lo, hi]` for option `what`, or the command line's message.
-fn within(x: f64, lo: f64, hi: f64, what: &str) -> Result<f64> {
-    parse_within(&x.to_string(), lo, hi, what).map_err(anyhow::Error::msg)
+/// [`in_range`] for a value given in code: `option: expected …`.
+fn within(option: &str, x: f64, range: (f64, f64), what: &str) -> Result<f64> {
+    in_range(x, range, what, &hooke_core::Num(x).to_string())
+        .map_err(|e| anyhow::anyhow!("{option}: {e}"))
 }
 
 impl View {
@@ -101,8 +117,11 @@ impl View {
         zoom: f64,
         supersample: u32,
     ) -> Result<Self> {
-        let size =
-            parse_size(&format!("{width}x{height}")).map_err(|e| anyhow::anyhow!("size: {e}"))?;
+        if !(SIDE.contains(&width) && SIDE.contains(&height)) {
+            anyhow::bail!(
+                "size: expected WIDTHxHEIGHT with each from 8 to 8192, found '{width}x{height}'"
+            );
+        }
         let style = <Style as clap::ValueEnum>::from_str(style, true).map_err(|_| {
             anyhow::anyhow!("style: expected solid, springs or both, found '{style}'")
         })?;
@@ -110,11 +129,11 @@ impl View {
             anyhow::bail!("supersample: expected 1 to 4, found {supersample}");
         }
         Ok(Self {
-            size,
+            size: (width, height),
             style,
-            yaw: within(yaw, -3600.0, 3600.0, "an angle in degrees").context("yaw")?,
-            pitch: within(pitch, -89.0, 89.0, "an elevation in degrees").context("pitch")?,
-            zoom: within(zoom, 1e-3, 1e3, "a zoom factor").context("zoom")?,
+            yaw: within("yaw", yaw, YAW, "an angle in degrees")?,
+            pitch: within("pitch", pitch, PITCH, "an elevation in degrees")?,
+            zoom: within("zoom", zoom, ZOOM, "a zoom factor")?,
             supersample,
         })
     }
