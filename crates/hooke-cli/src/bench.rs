@@ -119,6 +119,46 @@ struct ClothFigures {
     fastest_step_s: f64,
     median_spring_updates_per_s: f64,
     center_y: f64,
+    /// The STREAM triad's bandwidth measured in the same run on the same threads, bytes/s.
+    triad_bytes_per_s: f64,
+    /// The least a step must move: every particle's position and velocity read and written
+    /// (96 bytes) and the spring list read (two 4-byte ends and an 8-byte rest length).
+    bytes_per_step: f64,
+    /// The steps per second the triad's bandwidth allows, and the median step's share of it.
+    limit_steps_per_s: f64,
+    share_of_limit: f64,
+}
+
+/// Elements per array of [`triad`]: three arrays of 64 MiB, far beyond any cache.
+const TRIAD_LEN: usize = 1 << 23;
+
+/// The STREAM triad `a = b + s c` on the current rayon pool, in bytes per second (24 per
+/// element, as STREAM counts them): the best of five passes, after one that pages the
+/// arrays in.
+fn triad() -> f64 {
+    use rayon::prelude::*;
+    let (mut a, b, c) = (
+        vec![0.0f64; TRIAD_LEN],
+        vec![1.0f64; TRIAD_LEN],
+        vec![2.0f64; TRIAD_LEN],
+    );
+    let chunk = TRIAD_LEN.div_ceil(4 * rayon::current_num_threads());
+    let mut best = f64::INFINITY;
+    for pass in 0..6 {
+        let started = Instant::now();
+        a.par_chunks_mut(chunk)
+            .zip(b.par_chunks(chunk).zip(c.par_chunks(chunk)))
+            .for_each(|(a, (b, c))| {
+                for ((a, b), c) in a.iter_mut().zip(b).zip(c) {
+                    *a = b + 3.0 * c;
+                }
+            });
+        if pass > 0 {
+            best = best.min(started.elapsed().as_secs_f64());
+        }
+    }
+    std::hint::black_box(&a);
+    (24 * TRIAD_LEN) as f64 / best
 }
 
 /// Step times of a timed run: the median and the shortest, over at most the first
@@ -317,6 +357,9 @@ fn cloth(
     use_kernel(&mut scene.simulation, kernel)?;
     let (times, seconds) = StepTimes::run(&mut scene.simulation, steps, |_| ())?;
     let springs = scene.simulation.model().springs.len();
+    let triad_bytes_per_s = triad();
+    let bytes_per_step = (96 * n * n + 16 * springs) as f64;
+    let limit_steps_per_s = triad_bytes_per_s / bytes_per_step;
     let figures = ClothFigures {
         n,
         steps,
@@ -332,6 +375,10 @@ fn cloth(
         fastest_step_s: times.fastest(),
         median_spring_updates_per_s: springs as f64 / times.median(),
         center_y: scene.simulation.particles().x[workload::centre(n)].y,
+        triad_bytes_per_s,
+        bytes_per_step,
+        limit_steps_per_s,
+        share_of_limit: 1.0 / times.median() / limit_steps_per_s,
     };
     if json {
         println!("{}", serde_json::to_string(&figures)?);
@@ -339,7 +386,9 @@ fn cloth(
         println!(
             "cloth N={n}{}: {springs} springs, {steps} {integrator} steps on {} threads ({} \
              kernel) in {:.3} s: {:.1} steps/s, {:.1} M spring updates/s; median step {:.3} \
-             ms ({:.1} M/s), fastest {:.3} ms; centre y = {:.12}",
+             ms ({:.1} M/s), fastest {:.3} ms; centre y = {:.12}\n  bandwidth: triad {:.1} GB/s, \
+             a step moves at least {:.1} MB, so at most {:.1} steps/s; the median step runs at \
+             {:.2} of that",
             if air { " in air" } else { "" },
             figures.threads,
             figures.kernel,
@@ -349,7 +398,11 @@ fn cloth(
             figures.median_step_s * 1e3,
             figures.median_spring_updates_per_s / 1e6,
             figures.fastest_step_s * 1e3,
-            figures.center_y
+            figures.center_y,
+            triad_bytes_per_s / 1e9,
+            bytes_per_step / 1e6,
+            limit_steps_per_s,
+            figures.share_of_limit
         );
     }
     Ok(ExitCode::SUCCESS)

@@ -11,7 +11,7 @@
 //! buffers add little memory beyond one force per particle, and each partition reads
 //! positions from a small, cache-resident stretch of the arrays.
 
-use crate::kernel::{Kernel, ScatterArgs};
+use crate::kernel::{Kernel, MAX_OFFSETS, RUN_CHUNK, Run, RunArgs, ScatterArgs};
 use crate::model::Model;
 use crate::particles::Vec3;
 use crate::spring::Spring;
@@ -124,12 +124,21 @@ impl SpringTable {
 
 #[derive(Clone, Debug)]
 struct Partition {
+    /// The partition's springs, by assembly index.
     springs: Range<usize>,
+    /// Its pieces of runs in `Assembly::runs`, when it is laid out as runs; empty when its
+    /// springs are stored in sorted order for the per-spring loop.
+    runs: Range<usize>,
     /// The first particle of the window.
     lo: usize,
     /// One force per particle of the window `lo..lo + force.len()`.
     force: Vec<Vec3>,
 }
+
+/// The fewest springs per piece, on average, for a partition to be laid out as runs: below
+/// it the per-spring loop, which batches springs across lower ends, is faster (a jelly
+/// cube's rows of 8 particles make pieces of at most 7, and ran 10 % slower as runs).
+const MIN_AVERAGE_PIECE: usize = 8;
 
 /// Runs `f` on every partition: in parallel when there are several, inline for one (a small
 /// system, where a rayon call would cost more than the springs).
@@ -143,9 +152,18 @@ fn each_partition(partitions: &mut [Partition], f: impl Fn(&mut Partition) + Syn
 
 /// The solver's view of a model's springs, built once per run and reused every evaluation.
 /// It copies the springs: rebuild it (a new [`crate::Workspace`]) after editing them.
+///
+/// Springs are sorted by their lower end, then upper end, and cut into partitions of
+/// consecutive springs. A partition whose springs all belong to *runs* (springs whose ends
+/// both advance by one particle from one to the next, see `kernel::run_loop`) is stored
+/// as pieces of runs; any other keeps the sorted order for the per-spring loop. A mesh
+/// numbered row by row (a grid, an extruded shape, the jelly) is all runs whatever its
+/// shape; a graph without such regularity is laid out as before. Both loops add every
+/// force in the sorted order's sequence, so the layout changes no bit of any result.
 #[derive(Clone, Debug, Default)]
 pub struct Assembly {
     table: SpringTable,
+    runs: Vec<Run>,
     partitions: Vec<Partition>,
     /// For reduction block `b`, `block_parts[block_start[b]..block_start[b + 1]]` are the
     /// partitions whose window meets it, in order.
@@ -155,6 +173,72 @@ pub struct Assembly {
     kernel: Kernel,
 }
 
+/// The pieces of runs of one partition's springs (`sorted`, model indices in sorted order),
+/// each a lower end, an offset and its springs, in the order the run loop takes them: by
+/// chunk of [`RUN_CHUNK`] lower ends, then by offset from the largest. `None` when the
+/// partition is better or only correctly served by the per-spring loop: short pieces, a
+/// chunk with pieces of more than [`MAX_OFFSETS`] offsets, or a spring given twice (whose two forces the
+/// sorted order adds in the model's order, which pieces do not keep).
+fn pieces(
+    springs: &[Spring],
+    sorted: &[u32],
+    min_average: usize,
+) -> Option<Vec<(u32, u32, Vec<u32>)>> {
+    let ends = |k: u32| {
+        let s = &springs[k as usize];
+        (s.i.min(s.j), s.i.max(s.j))
+    };
+    let mut by_offset = sorted.to_vec();
+    by_offset.sort_by_key(|&k| {
+        let (i, j) = ends(k);
+        (j - i, i)
+    });
+    let mut pieces = Vec::new();
+    let mut start = 0;
+    while start < by_offset.len() {
+        let (i0, j0) = ends(by_offset[start]);
+        let mut end = start + 1;
+        while end < by_offset.len() {
+            let (i, j) = ends(by_offset[end]);
+            if (i, j) == ends(by_offset[end - 1]) {
+                return None;
+            }
+            let k = (end - start) as u32;
+            if i != i0 + k || j != j0 + k {
+                break;
+            }
+            end += 1;
+        }
+        // Cut where the lower ends cross a multiple of the chunk.
+        let mut piece = start;
+        while piece < end {
+            let lo = i0 + (piece - start) as u32;
+            let chunk_end = (lo as usize / RUN_CHUNK + 1) * RUN_CHUNK;
+            let stop = end.min(piece + chunk_end - lo as usize);
+            pieces.push((lo, j0 - i0, by_offset[piece..stop].to_vec()));
+            piece = stop;
+        }
+        start = end;
+    }
+    if pieces.len() * min_average > sorted.len() {
+        return None;
+    }
+    pieces.sort_by_key(|&(lo, offset, _)| (lo as usize / RUN_CHUNK, std::cmp::Reverse(offset)));
+    let mut offsets = 0;
+    for k in 0..pieces.len() {
+        let chunk = pieces[k].0 as usize / RUN_CHUNK;
+        if k == 0 || chunk != pieces[k - 1].0 as usize / RUN_CHUNK {
+            offsets = 1;
+        } else if pieces[k].1 != pieces[k - 1].1 {
+            offsets += 1;
+        }
+        if offsets > MAX_OFFSETS {
+            return None;
+        }
+    }
+    Some(pieces)
+}
+
 impl Assembly {
     /// Lays out `springs` over `particles` particles.
     ///
@@ -162,6 +246,16 @@ impl Assembly {
     /// If a spring names a particle that does not exist (a builder bug, not user input: scene
     /// loaders validate indices first).
     pub fn new(particles: usize, springs: &[Spring]) -> Self {
+        Self::laid_out(particles, springs, Some(MIN_AVERAGE_PIECE))
+    }
+
+    /// [`Assembly::new`] with runs in partitions whose pieces average at least
+    /// `min_average` springs, or with none (for tests that compare the two loops).
+    pub(crate) fn laid_out(
+        particles: usize,
+        springs: &[Spring],
+        min_average: Option<usize>,
+    ) -> Self {
         for (k, s) in springs.iter().enumerate() {
             assert!(
                 (s.i as usize) < particles && (s.j as usize) < particles,
@@ -178,7 +272,7 @@ impl Assembly {
         let mut table = SpringTable::default();
         let mut rest = Vec::with_capacity(springs.len());
         let mut seen = HashMap::new();
-        for &k in &order {
+        let mut push = |table: &mut SpringTable, k: u32| {
             let s = &springs[k as usize];
             // Lower index first: the force on the other end is the exact negation.
             table.ends.push([s.i.min(s.j), s.i.max(s.j)]);
@@ -186,25 +280,47 @@ impl Assembly {
             let key = [s.ks.to_bits(), s.kd.to_bits()];
             let index = intern(&mut seen, &mut table.params, key, [s.ks, s.kd]);
             table.param.push(index as u32);
+        };
+        let size = partition_size(springs.len());
+        let mut runs = Vec::new();
+        let mut partitions = Vec::new();
+        for start in (0..springs.len()).step_by(size) {
+            let range = start..(start + size).min(springs.len());
+            let first_run = runs.len();
+            match min_average.and_then(|min| pieces(springs, &order[range.clone()], min)) {
+                Some(pieces) => {
+                    for (lo, offset, members) in pieces {
+                        runs.push(Run {
+                            lo,
+                            offset,
+                            len: members.len() as u32,
+                            first: table.ends.len() as u32,
+                        });
+                        for k in members {
+                            push(&mut table, k);
+                        }
+                    }
+                }
+                None => {
+                    for &k in &order[range.clone()] {
+                        push(&mut table, k);
+                    }
+                }
+            }
+            let ends = table.ends[range.clone()].iter().flatten();
+            let lo = ends.clone().copied().min().unwrap_or(0) as usize;
+            let hi = ends.copied().max().unwrap_or(0) as usize;
+            partitions.push(Partition {
+                springs: range,
+                runs: first_run..runs.len(),
+                lo,
+                force: vec![Vec3::zeros(); hi + 1 - lo],
+            });
         }
         if table.params.len() == 1 {
             table.param = Vec::new();
         }
         table.rest = RestLengths::new(rest);
-        let partitions: Vec<Partition> = (0..springs.len())
-            .step_by(partition_size(springs.len()))
-            .map(|start| {
-                let range = start..(start + partition_size(springs.len())).min(springs.len());
-                let ends = table.ends[range.clone()].iter().flatten();
-                let lo = ends.clone().copied().min().unwrap_or(0) as usize;
-                let hi = ends.copied().max().unwrap_or(0) as usize;
-                Partition {
-                    springs: range,
-                    lo,
-                    force: vec![Vec3::zeros(); hi + 1 - lo],
-                }
-            })
-            .collect();
         let blocks = particles.div_ceil(REDUCE_BLOCK);
         let mut block_start = vec![0u32];
         let mut block_parts = Vec::new();
@@ -219,12 +335,19 @@ impl Assembly {
         }
         Self {
             table,
+            runs,
             partitions,
             block_start,
             block_parts,
             particles,
             kernel: Kernel::detect(),
         }
+    }
+
+    /// How many springs the layout keeps in runs.
+    #[cfg(test)]
+    pub(crate) fn springs_in_runs(&self) -> usize {
+        self.runs.iter().map(|r| r.len as usize).sum()
     }
 
     /// The compilation of the force loop in use: [`Kernel::detect`]'s unless set.
@@ -247,19 +370,51 @@ impl Assembly {
 
     /// Computes every spring's force at `(x, v)` into the partition buffers.
     pub fn scatter(&mut self, x: &[Vec3], v: &[Vec3]) {
-        let (table, kernel) = (&self.table, self.kernel);
+        let (table, runs, kernel) = (&self.table, &self.runs[..], self.kernel);
         let scatter = |part: &mut Partition| {
             part.force.fill(Vec3::zeros());
+            let uniform = table.param.is_empty();
+            let (lo, force) = (part.lo, &mut part.force[..]);
+            let params = &table.params[..];
+            let runs = &runs[part.runs.clone()];
+            if !runs.is_empty() {
+                macro_rules! runs {
+                    ($rest:expr) => {
+                        RunArgs {
+                            runs,
+                            rest: $rest,
+                            param: &table.param,
+                            params,
+                            lo,
+                            force: &mut *force,
+                            x,
+                            v,
+                        }
+                    };
+                }
+                match (&table.rest, uniform) {
+                    (RestLengths::Indexed(index, rests), true) => {
+                        kernel.scatter_runs::<true, _>(runs!((&index[..], &rests[..])))
+                    }
+                    (RestLengths::Indexed(index, rests), false) => {
+                        kernel.scatter_runs::<false, _>(runs!((&index[..], &rests[..])))
+                    }
+                    (RestLengths::Each(rest), true) => {
+                        kernel.scatter_runs::<true, _>(runs!(&rest[..]))
+                    }
+                    (RestLengths::Each(rest), false) => {
+                        kernel.scatter_runs::<false, _>(runs!(&rest[..]))
+                    }
+                }
+                return;
+            }
             let r = part.springs.clone();
             let ends = &table.ends[r.clone()];
-            let uniform = table.param.is_empty();
             let param = if uniform {
                 &[][..]
             } else {
                 &table.param[r.clone()]
             };
-            let (lo, force) = (part.lo, &mut part.force[..]);
-            let params = &table.params[..];
             macro_rules! args {
                 ($rest:expr) => {
                     ScatterArgs {

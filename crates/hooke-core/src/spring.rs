@@ -93,7 +93,7 @@ pub(crate) fn spring_force(d: Vec3, dv: Vec3, rest: f64, ks: f64, kd: f64) -> Ve
 /// width: square roots and divisions, the bottleneck of a spring, then run several springs
 /// per instruction.
 #[inline(always)]
-fn spring_formula(d: [f64; 3], dv: [f64; 3], rest: f64, ks: f64, kd: f64) -> [f64; 3] {
+pub(crate) fn spring_formula(d: [f64; 3], dv: [f64; 3], rest: f64, ks: f64, kd: f64) -> [f64; 3] {
     let [dx, dy, dz] = d;
     let [vx, vy, vz] = dv;
     let len = (dx * dx + dy * dy + dz * dz).sqrt();

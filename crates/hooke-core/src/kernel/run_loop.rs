@@ -1,0 +1,277 @@
+//! The force loop over runs: springs `(i + k, i + d + k)` for `k` in `0..len`, whose two
+//! ends both advance one particle per spring.
+//!
+//! A run needs no end indices: its springs read two contiguous stretches of positions and
+//! velocities and add their forces into two contiguous stretches of the window, so every
+//! load and store moves whole vectors and the prefetcher sees plain streams. Meshes built
+//! row by row (grids, extruded shapes, the jelly) are mostly runs; [`crate::Assembly`] finds
+//! them and leaves the rest to [`super::force_loop`].
+//!
+//! Springs go four at a time: the AVX2 kernel loads four upper ends' coordinates as twelve
+//! consecutive values, transposes them in registers, computes the four forces in one
+//! instruction per operation and transposes them back (`run_avx2.rs`); the portable
+//! kernel does the same lane by lane. The lower ends of a chunk of runs sit in component
+//! layout throughout.
+
+use super::force_loop::RestLookup;
+use crate::particles::Vec3;
+use crate::spring::spring_formula;
+
+/// Lower ends per chunk of runs: the layout cuts runs where their lower ends cross a
+/// multiple of it, and the loop handles one chunk's pieces together.
+pub(crate) const RUN_CHUNK: usize = 32;
+
+/// Springs computed together.
+pub(crate) const GROUP: usize = 4;
+
+/// The most distinct offsets the pieces of one chunk may have (the layout keeps partitions
+/// with more for the per-spring loop): a cloth has 6, a lattice with every neighbour to
+/// distance two 13.
+pub(crate) const MAX_OFFSETS: usize = 16;
+
+/// A run of springs in the solver's layout: springs `first..first + len` of the assembly
+/// join particle `lo + k` to `lo + offset + k`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Run {
+    /// The lower end of the run's first spring.
+    pub lo: u32,
+    /// How far above its lower end each spring's upper end is.
+    pub offset: u32,
+    /// Springs in the run.
+    pub len: u32,
+    /// The assembly index of the run's first spring (its rest length and parameters).
+    pub first: u32,
+}
+
+/// The arguments of [`scatter_runs`] for one partition.
+pub(crate) struct RunArgs<'a, R> {
+    /// The partition's runs.
+    pub runs: &'a [Run],
+    /// Rest lengths, by assembly spring index.
+    pub rest: R,
+    /// Each spring's index into `params`, by assembly index (empty when uniform).
+    pub param: &'a [u32],
+    /// The distinct `(ks, kd)` pairs.
+    pub params: &'a [[f64; 2]],
+    /// The window's first particle.
+    pub lo: usize,
+    /// The window's forces, particle `lo + k` at `k`.
+    pub force: &'a mut [Vec3],
+    /// Positions.
+    pub x: &'a [Vec3],
+    /// Velocities.
+    pub v: &'a [Vec3],
+}
+
+/// A chunk's lower ends in component layout, read once per chunk, and the forces of its
+/// pieces, one row per offset (pieces of one offset cover distinct lower ends), kept until
+/// the chunk's lower ends take their sums.
+struct Chunk {
+    x: [[f64; RUN_CHUNK]; 3],
+    v: [[f64; RUN_CHUNK]; 3],
+    forces: [[[f64; RUN_CHUNK]; 3]; MAX_OFFSETS],
+    pull: [[f64; RUN_CHUNK]; 3],
+    lower: [bool; RUN_CHUNK],
+}
+
+/// Four consecutive springs of a piece, as [`scatter_runs`] hands them to a group step.
+pub(crate) struct Group<'a> {
+    /// The lower ends' positions and velocities, by component.
+    pub x: [&'a [f64; GROUP]; 3],
+    pub v: [&'a [f64; GROUP]; 3],
+    /// Where the step writes the four forces, by component.
+    pub keep: [&'a mut [f64; GROUP]; 3],
+    /// The upper ends' flat positions and velocities.
+    pub xb: &'a [f64; 3 * GROUP],
+    pub vb: &'a [f64; 3 * GROUP],
+    /// The upper ends' flat forces: the step subtracts each spring's force.
+    pub out: &'a mut [f64; 3 * GROUP],
+    /// Rest lengths, stiffnesses and dampings.
+    pub rest: [f64; GROUP],
+    pub ks: [f64; GROUP],
+    pub kd: [f64; GROUP],
+}
+
+/// Lanes `a..a + GROUP` of a chunk's row.
+#[inline(always)]
+fn lanes(row: &[f64; RUN_CHUNK], a: usize) -> &[f64; GROUP] {
+    row[a..a + GROUP].try_into().expect("four lanes")
+}
+
+/// Lanes `a..a + GROUP` of a chunk's row, to write.
+#[inline(always)]
+fn lanes_mut(row: &mut [f64; RUN_CHUNK], a: usize) -> &mut [f64; GROUP] {
+    (&mut row[a..a + GROUP]).try_into().expect("four lanes")
+}
+
+/// The group step of the portable kernel: lane by lane with [`spring_formula`], the same
+/// operations in the same order as every other kernel's.
+#[inline(always)]
+pub(crate) fn group_by_lane(g: Group) {
+    for l in 0..GROUP {
+        let d = [0, 1, 2].map(|c| g.x[c][l] - g.xb[3 * l + c]);
+        let dv = [0, 1, 2].map(|c| g.v[c][l] - g.vb[3 * l + c]);
+        let f = spring_formula(d, dv, g.rest[l], g.ks[l], g.kd[l]);
+        for (c, f) in f.into_iter().enumerate() {
+            g.keep[c][l] = f;
+            g.out[3 * l + c] -= f;
+        }
+    }
+}
+
+/// Adds the forces of every spring of `runs` into the window, four springs at a time
+/// through `group` (which must compute [`group_by_lane`]'s bits), in exactly the sequence of
+/// the per-spring loop over the same springs in sorted order (`super::force_loop`): each
+/// particle first loses the forces of the springs it is the upper end of, by ascending
+/// lower end, then gains once the sum of those it is the lower end of, taken by ascending
+/// upper end.
+///
+/// Runs come cut into pieces within one chunk of [`RUN_CHUNK`] lower ends each, sorted by
+/// chunk and then by offset from the largest. A chunk's lower ends are loaded into
+/// component layout once; each piece then loads only its upper ends, computes its forces
+/// and subtracts them from its upper ends: by descending offset, which is ascending lower
+/// end for any one upper end. The pieces' forces are kept, and once the chunk is done each
+/// lower end sums its pieces' by ascending offset and adds the sum to the window.
+#[inline(always)]
+pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup>(
+    RunArgs {
+        runs,
+        rest,
+        param,
+        params,
+        lo,
+        force,
+        x,
+        v,
+    }: RunArgs<R>,
+    mut group: impl FnMut(Group),
+) {
+    let (x, v): (&[f64], &[f64]) = (bytemuck::cast_slice(x), bytemuck::cast_slice(v));
+    let force: &mut [f64] = bytemuck::cast_slice_mut(force);
+    // On the stack (15 KiB): stepping allocates nothing.
+    let mut chunk = Chunk {
+        x: [[0.0; RUN_CHUNK]; 3],
+        v: [[0.0; RUN_CHUNK]; 3],
+        forces: [[[0.0; RUN_CHUNK]; 3]; MAX_OFFSETS],
+        pull: [[0.0; RUN_CHUNK]; 3],
+        lower: [false; RUN_CHUNK],
+    };
+    let mut start = 0;
+    while start < runs.len() {
+        let at = runs[start].lo as usize / RUN_CHUNK;
+        let end = start
+            + runs[start..]
+                .iter()
+                .take_while(|r| r.lo as usize / RUN_CHUNK == at)
+                .count();
+        let pieces = &runs[start..end];
+        // Each piece's row: pieces come by descending offset, and the layout keeps at most
+        // `MAX_OFFSETS` offsets per chunk (`chunk.forces` has that many rows).
+        let rows = 1 + pieces
+            .windows(2)
+            .filter(|w| w[0].offset != w[1].offset)
+            .count();
+        let first = pieces.iter().map(|r| r.lo).min().unwrap_or(0) as usize;
+        let last = pieces.iter().map(|r| r.lo + r.len).max().unwrap_or(0) as usize;
+        let span = (last - first).min(RUN_CHUNK);
+        let chunk = &mut chunk;
+        let (xs, vs) = (
+            &x[3 * first..3 * (first + span)],
+            &v[3 * first..3 * (first + span)],
+        );
+        for c in 0..3 {
+            for l in 0..span {
+                chunk.x[c][l] = xs[3 * l + c];
+                chunk.v[c][l] = vs[3 * l + c];
+            }
+        }
+        // Zero where no piece of a row writes, so that every row adds in whole; a row's
+        // zeros add nothing to a pull, which starts at +0 and so is never -0.
+        for row in &mut chunk.forces[..rows] {
+            for c in row.iter_mut() {
+                c[..span].fill(0.0);
+            }
+        }
+        let mut q = 0;
+        for (p, piece) in pieces.iter().enumerate() {
+            if p > 0 && piece.offset != pieces[p - 1].offset {
+                q += 1;
+            }
+            let i = piece.lo as usize - first;
+            let n = (piece.len as usize).min(span - i);
+            let j = piece.lo as usize + piece.offset as usize;
+            let k = piece.first as usize;
+            let (xb, vb) = (&x[3 * j..3 * (j + n)], &v[3 * j..3 * (j + n)]);
+            let out = &mut force[3 * (j - lo)..3 * (j - lo + n)];
+            let rest = rest.slice(k..k + n);
+            let param = if UNIFORM { &[][..] } else { &param[k..k + n] };
+            let ks_kd = |l: usize| {
+                if UNIFORM {
+                    params[0]
+                } else {
+                    params[param[l] as usize]
+                }
+            };
+            let kept = &mut chunk.forces[q];
+            let mut g = 0;
+            while g + GROUP <= n {
+                let a = i + g;
+                let [f0, f1, f2] = &mut *kept;
+                let pairs: [[f64; 2]; GROUP] = std::array::from_fn(|l| ks_kd(g + l));
+                group(Group {
+                    x: [0, 1, 2].map(|c| lanes(&chunk.x[c], a)),
+                    v: [0, 1, 2].map(|c| lanes(&chunk.v[c], a)),
+                    keep: [lanes_mut(f0, a), lanes_mut(f1, a), lanes_mut(f2, a)],
+                    xb: xb[3 * g..3 * (g + GROUP)]
+                        .try_into()
+                        .expect("twelve values"),
+                    vb: vb[3 * g..3 * (g + GROUP)]
+                        .try_into()
+                        .expect("twelve values"),
+                    out: (&mut out[3 * g..3 * (g + GROUP)])
+                        .try_into()
+                        .expect("twelve values"),
+                    rest: std::array::from_fn(|l| rest.rest(g + l)),
+                    ks: pairs.map(|p| p[0]),
+                    kd: pairs.map(|p| p[1]),
+                });
+                g += GROUP;
+            }
+            for l in g..n {
+                let a = i + l;
+                let dx = [0, 1, 2].map(|c| chunk.x[c][a] - xb[3 * l + c]);
+                let dv = [0, 1, 2].map(|c| chunk.v[c][a] - vb[3 * l + c]);
+                let [ks, kd] = ks_kd(l);
+                let f = spring_formula(dx, dv, rest.rest(l), ks, kd);
+                for c in 0..3 {
+                    kept[c][a] = f[c];
+                    out[3 * l + c] -= f[c];
+                }
+            }
+        }
+        // Each lower end's pull: its pieces' forces by ascending offset, from zero.
+        for c in 0..3 {
+            chunk.pull[c][..span].fill(0.0);
+            for row in chunk.forces[..rows].iter().rev() {
+                for (p, f) in chunk.pull[c][..span].iter_mut().zip(&row[c][..span]) {
+                    *p += f;
+                }
+            }
+        }
+        chunk.lower[..span].fill(false);
+        for piece in pieces {
+            let i = piece.lo as usize - first;
+            let n = (piece.len as usize).min(span - i);
+            chunk.lower[i..i + n].fill(true);
+        }
+        let out = &mut force[3 * (first - lo)..3 * (first - lo + span)];
+        for l in 0..span {
+            if chunk.lower[l] {
+                for c in 0..3 {
+                    out[3 * l + c] += chunk.pull[c][l];
+                }
+            }
+        }
+        start = end;
+    }
+}
