@@ -130,9 +130,10 @@ fn every_force_kernel_gives_the_same_trajectory() {
 /// Symplectic Euler checks each block of particles for divergence as it updates it,
 /// instead of a separate scan: the first bad step must still be the one reported. At 40×
 /// the stable step the workload blows up within some steps; the state one step before
-/// the reported one is sane, and the reported particle is the first bad one. Without
-/// contact responses no start positions are kept: the report's step-size estimate, made
-/// from positions rebuilt by undoing the step, must match the one at the actual start.
+/// the reported one is sane, and the reported particle is the first bad one. The step
+/// writes its new state beside the old, which it keeps as the start positions: they must
+/// be the previous step's positions to the bit, and the report's step-size estimate, made
+/// from them, the one at the actual start.
 #[test]
 fn symplectic_reports_the_first_diverged_step_and_particle() {
     let spec = || {
@@ -158,7 +159,14 @@ fn symplectic_reports_the_first_diverged_step_and_particle() {
     let after = scene.simulation.particles();
     let first_bad = (0..after.len()).find(|&i| !sane(&after.x[i], &after.v[i]));
     assert_eq!(first_bad, Some(err.particle));
-    assert!(scene.simulation.start_positions().is_none());
+    let start = scene
+        .simulation
+        .start_positions()
+        .expect("symplectic keeps its start");
+    assert!(
+        start == &p.x[..],
+        "start positions differ from the step before"
+    );
     let limit = before.simulation.stability().max_dt(Integrator::Symplectic);
     let relative = (err.suggested_dt / (0.5 * limit) - 1.0).abs();
     assert!(

@@ -11,6 +11,8 @@
 //! buffers add little memory beyond one force per particle, and each partition reads
 //! positions from a small, cache-resident stretch of the arrays.
 
+mod fused;
+
 use crate::kernel::{Kernel, MAX_OFFSETS, RUN_CHUNK, Run, RunArgs, ScatterArgs};
 use crate::model::Model;
 use crate::particles::Vec3;
@@ -169,6 +171,10 @@ pub struct Assembly {
     /// partitions whose window meets it, in order.
     block_start: Vec<u32>,
     block_parts: Vec<u32>,
+    /// Where each partition's stretch of particles starts, then the particle count, and
+    /// whether every window ends before the stretch after next (see `fused.rs`).
+    stretch_at: Vec<usize>,
+    reach: bool,
     particles: usize,
     kernel: Kernel,
 }
@@ -237,6 +243,78 @@ fn pieces(
         }
     }
     Some(pieces)
+}
+
+/// Computes the forces of `part`'s springs at `(x, v)` into its window.
+fn scatter_partition(
+    (table, runs, kernel): (&SpringTable, &[Run], Kernel),
+    part: &mut Partition,
+    x: &[Vec3],
+    v: &[Vec3],
+) {
+    part.force.fill(Vec3::zeros());
+    let uniform = table.param.is_empty();
+    let (lo, force) = (part.lo, &mut part.force[..]);
+    let params = &table.params[..];
+    let runs = &runs[part.runs.clone()];
+    if !runs.is_empty() {
+        macro_rules! runs {
+            ($rest:expr) => {
+                RunArgs {
+                    runs,
+                    rest: $rest,
+                    param: &table.param,
+                    params,
+                    lo,
+                    force: &mut *force,
+                    x,
+                    v,
+                }
+            };
+        }
+        match (&table.rest, uniform) {
+            (RestLengths::Indexed(index, rests), true) => {
+                kernel.scatter_runs::<true, _>(runs!((&index[..], &rests[..])))
+            }
+            (RestLengths::Indexed(index, rests), false) => {
+                kernel.scatter_runs::<false, _>(runs!((&index[..], &rests[..])))
+            }
+            (RestLengths::Each(rest), true) => kernel.scatter_runs::<true, _>(runs!(&rest[..])),
+            (RestLengths::Each(rest), false) => kernel.scatter_runs::<false, _>(runs!(&rest[..])),
+        }
+        return;
+    }
+    let r = part.springs.clone();
+    let ends = &table.ends[r.clone()];
+    let param = if uniform {
+        &[][..]
+    } else {
+        &table.param[r.clone()]
+    };
+    macro_rules! args {
+        ($rest:expr) => {
+            ScatterArgs {
+                ends,
+                rest: $rest,
+                param,
+                params,
+                lo,
+                force,
+                x,
+                v,
+            }
+        };
+    }
+    match (&table.rest, uniform) {
+        (RestLengths::Indexed(index, rests), true) => {
+            kernel.scatter::<true, _>(args!((&index[r], &rests[..])))
+        }
+        (RestLengths::Indexed(index, rests), false) => {
+            kernel.scatter::<false, _>(args!((&index[r], &rests[..])))
+        }
+        (RestLengths::Each(rest), true) => kernel.scatter::<true, _>(args!(&rest[r])),
+        (RestLengths::Each(rest), false) => kernel.scatter::<false, _>(args!(&rest[r])),
+    }
 }
 
 impl Assembly {
@@ -333,12 +411,16 @@ impl Assembly {
             }
             block_start.push(block_parts.len() as u32);
         }
+        let stretch_at = Self::stretches(&partitions, particles);
+        let reach = Self::reaches_one_stretch(&partitions, &stretch_at);
         Self {
             table,
             runs,
             partitions,
             block_start,
             block_parts,
+            stretch_at,
+            reach,
             particles,
             kernel: Kernel::detect(),
         }
@@ -370,77 +452,10 @@ impl Assembly {
 
     /// Computes every spring's force at `(x, v)` into the partition buffers.
     pub fn scatter(&mut self, x: &[Vec3], v: &[Vec3]) {
-        let (table, runs, kernel) = (&self.table, &self.runs[..], self.kernel);
-        let scatter = |part: &mut Partition| {
-            part.force.fill(Vec3::zeros());
-            let uniform = table.param.is_empty();
-            let (lo, force) = (part.lo, &mut part.force[..]);
-            let params = &table.params[..];
-            let runs = &runs[part.runs.clone()];
-            if !runs.is_empty() {
-                macro_rules! runs {
-                    ($rest:expr) => {
-                        RunArgs {
-                            runs,
-                            rest: $rest,
-                            param: &table.param,
-                            params,
-                            lo,
-                            force: &mut *force,
-                            x,
-                            v,
-                        }
-                    };
-                }
-                match (&table.rest, uniform) {
-                    (RestLengths::Indexed(index, rests), true) => {
-                        kernel.scatter_runs::<true, _>(runs!((&index[..], &rests[..])))
-                    }
-                    (RestLengths::Indexed(index, rests), false) => {
-                        kernel.scatter_runs::<false, _>(runs!((&index[..], &rests[..])))
-                    }
-                    (RestLengths::Each(rest), true) => {
-                        kernel.scatter_runs::<true, _>(runs!(&rest[..]))
-                    }
-                    (RestLengths::Each(rest), false) => {
-                        kernel.scatter_runs::<false, _>(runs!(&rest[..]))
-                    }
-                }
-                return;
-            }
-            let r = part.springs.clone();
-            let ends = &table.ends[r.clone()];
-            let param = if uniform {
-                &[][..]
-            } else {
-                &table.param[r.clone()]
-            };
-            macro_rules! args {
-                ($rest:expr) => {
-                    ScatterArgs {
-                        ends,
-                        rest: $rest,
-                        param,
-                        params,
-                        lo,
-                        force,
-                        x,
-                        v,
-                    }
-                };
-            }
-            match (&table.rest, uniform) {
-                (RestLengths::Indexed(index, rests), true) => {
-                    kernel.scatter::<true, _>(args!((&index[r], &rests[..])))
-                }
-                (RestLengths::Indexed(index, rests), false) => {
-                    kernel.scatter::<false, _>(args!((&index[r], &rests[..])))
-                }
-                (RestLengths::Each(rest), true) => kernel.scatter::<true, _>(args!(&rest[r])),
-                (RestLengths::Each(rest), false) => kernel.scatter::<false, _>(args!(&rest[r])),
-            }
-        };
-        each_partition(&mut self.partitions, scatter);
+        let layout = (&self.table, &self.runs[..], self.kernel);
+        each_partition(&mut self.partitions, |part| {
+            scatter_partition(layout, part, x, v)
+        });
     }
 
     /// Scatters an antisymmetric per-spring quantity: `g(k, i, j)` is added at the spring's

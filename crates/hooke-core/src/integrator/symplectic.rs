@@ -1,12 +1,11 @@
 //! Semi-implicit (symplectic) Euler: `v' = v + dt a(x, v)`, then `x' = x + dt v'`.
 //!
-//! The force gather, the update, saving the start positions and the divergence check are
-//! one pass over the particles: the method that benchmarks run streams each array once per
-//! step. The start positions are saved only for models with a contact phase, the one
-//! reader that needs them exactly (see [`StepReport::saved_start`]).
+//! The spring forces, their sums, the update and the divergence check are one pass over the
+//! partitions and particles ([`crate::Assembly`]'s `scatter_and_finish`): the method that
+//! benchmarks run streams each array about once per step. The new state is written beside
+//! the old one, whose positions then serve as the start positions.
 
 use super::{StepReport, Workspace};
-use crate::assembly::{BLOCK, REDUCE_BLOCK};
 use crate::model::Model;
 use crate::parallel;
 use crate::particles::{Particles, SANE_BOUND, Vec3};
@@ -20,65 +19,60 @@ pub(super) fn step(
     (t, dt): (f64, f64),
     ws: &mut Workspace,
 ) -> StepReport {
-    let save = model.has_contact_phase();
-    let sane = match (model.gravity_only(), save) {
-        (true, true) => update::<true, true>(model, p, (t, dt), ws),
-        (true, false) => update::<true, false>(model, p, (t, dt), ws),
-        (false, true) => update::<false, true>(model, p, (t, dt), ws),
-        (false, false) => update::<false, false>(model, p, (t, dt), ws),
+    let sane = if model.gravity_only() {
+        update::<true>(model, p, (t, dt), ws)
+    } else {
+        update::<false>(model, p, (t, dt), ws)
     };
     StepReport {
-        saved_start: save,
+        saved_start: true,
         verdict: Some(sane),
     }
 }
 
 /// The step; with `GRAVITY_ONLY` (see [`Model::gravity_only`]) the external force is
-/// `m g`, without the general per-particle tests; with `SAVE_START` the start positions
-/// go to `x0`. Returns whether the state it wrote is sane.
-fn update<const GRAVITY_ONLY: bool, const SAVE_START: bool>(
+/// `m g`, without the general per-particle tests. The new state goes to the workspace's
+/// spare arrays, which then trade places with the particles' (so the old positions become
+/// the start positions, at no cost). Returns whether the state it wrote is sane.
+fn update<const GRAVITY_ONLY: bool>(
     model: &Model,
     p: &mut Particles,
     (t, dt): (f64, f64),
     ws: &mut Workspace,
 ) -> bool {
     let air = ws.air.evaluate(model, &p.x, &p.v, t);
-    ws.assembly.scatter(&p.x, &p.v);
-    let asm = &ws.assembly;
-    let (mass, inv_mass) = (&p.mass, &p.inv_mass);
-    parallel::all_blocks3(BLOCK, &mut p.x, &mut p.v, &mut ws.x0, |start, x, v, x0| {
-        let mut springs = [Vec3::zeros(); REDUCE_BLOCK];
-        let mut sane = true;
-        let chunks = x.chunks_mut(REDUCE_BLOCK).zip(v.chunks_mut(REDUCE_BLOCK));
-        for (c, ((x, v), x0)) in chunks.zip(x0.chunks_mut(REDUCE_BLOCK)).enumerate() {
-            let start = start + c * REDUCE_BLOCK;
-            let n = x.len().min(v.len()).min(x0.len());
-            let springs = &mut springs[..n];
-            asm.gather_block(start, springs);
-            let (mass, inv_mass) = (&mass[start..start + n], &inv_mass[start..start + n]);
-            for k in 0..n {
-                if SAVE_START {
-                    x0[k] = x[k];
-                }
-                if inv_mass[k] == 0.0 {
-                    continue;
-                }
-                let f = if GRAVITY_ONLY {
-                    model.gravity * mass[k] + springs[k]
-                } else {
-                    // Without air nothing is added, so vacuum runs keep every bit.
-                    let pairwise = if air.is_empty() {
-                        springs[k]
-                    } else {
-                        springs[k] + air[start + k]
-                    };
-                    model.total_force(start + k, mass[k], &x[k], &v[k], pairwise)
-                };
-                v[k] += f * inv_mass[k] * dt;
-                x[k] += v[k] * dt;
+    let (x, v) = (&p.x[..], &p.v[..]);
+    let (mass, inv_mass) = (&p.mass[..], &p.inv_mass[..]);
+    let finish = |start: usize, springs: &[Vec3], xn: &mut [Vec3], vn: &mut [Vec3]| {
+        let n = springs.len().min(xn.len()).min(vn.len());
+        let (x, v) = (&x[start..start + n], &v[start..start + n]);
+        let (mass, inv_mass) = (&mass[start..start + n], &inv_mass[start..start + n]);
+        for k in 0..n {
+            if inv_mass[k] == 0.0 {
+                (xn[k], vn[k]) = (x[k], v[k]);
+                continue;
             }
-            sane &= parallel::sane(x, v, SANE_BOUND);
+            let f = if GRAVITY_ONLY {
+                model.gravity * mass[k] + springs[k]
+            } else {
+                // Without air nothing is added, so vacuum runs keep every bit.
+                let pairwise = if air.is_empty() {
+                    springs[k]
+                } else {
+                    springs[k] + air[start + k]
+                };
+                model.total_force(start + k, mass[k], &x[k], &v[k], pairwise)
+            };
+            vn[k] = v[k] + f * inv_mass[k] * dt;
+            xn[k] = x[k] + vn[k] * dt;
         }
-        sane
-    })
+        parallel::sane(&xn[..n], &vn[..n], SANE_BOUND)
+    };
+    let sane = ws
+        .assembly
+        .scatter_and_finish((x, v), (&mut ws.xt, &mut ws.vt), finish);
+    std::mem::swap(&mut p.x, &mut ws.xt);
+    std::mem::swap(&mut ws.xt, &mut ws.x0);
+    std::mem::swap(&mut p.v, &mut ws.vt);
+    sane
 }
