@@ -6,7 +6,7 @@
 use crate::draw::{DEFAULT_YAW_PITCH, Style, draw, frame_camera};
 use crate::source;
 use anyhow::{Context, Result, bail};
-use hooke_core::{Integrator, Kernel, Simulation};
+use hooke_core::{Integrator, Kernel, Renumbering, Simulation};
 use hooke_render::{RenderOptions, Renderer};
 use hooke_scene::spec::{AeroSpec, AirSpec, Finite, NonNegative, Positive};
 use hooke_scene::workload;
@@ -42,6 +42,13 @@ pub enum Bench {
         /// lift 0.3 on every triangle): compare with a run without it for the cost of air.
         #[arg(long)]
         air: bool,
+        /// Number the particles at random (by this seed), as a mesh that arrives unordered,
+        /// then renumber them for locality as any simulation can (`Simulation::renumber_for_locality`).
+        #[arg(long, value_name = "SEED")]
+        shuffle: Option<u64>,
+        /// With `--shuffle`: keep the random numbering, to measure what renumbering gains.
+        #[arg(long, requires = "shuffle")]
+        keep_order: bool,
         /// Print one JSON object instead of text.
         #[arg(long)]
         json: bool,
@@ -108,6 +115,10 @@ struct ClothFigures {
     kernel: String,
     /// Whether the workload ran in moving air (`--air`).
     air: bool,
+    /// The seed the particles were numbered at random by (`--shuffle`), and whether they
+    /// were then renumbered for locality.
+    shuffle: Option<u64>,
+    renumbered: bool,
     springs: usize,
     seconds: f64,
     steps_per_s: f64,
@@ -290,8 +301,13 @@ pub fn run(bench: &Bench) -> Result<ExitCode> {
             integrator,
             kernel,
             air,
+            shuffle,
+            keep_order,
             json,
-        } => pool(*threads)?.install(|| cloth(*n, *steps, *integrator, *kernel, *air, *json)),
+        } => {
+            let order = shuffle.map(|seed| (seed, !keep_order));
+            pool(*threads)?.install(|| cloth(*n, *steps, *integrator, *kernel, *air, order, *json))
+        }
         Bench::Scene {
             scene,
             steps,
@@ -340,21 +356,43 @@ fn use_kernel(sim: &mut Simulation, kernel: Option<Kernel>) -> Result<()> {
     Ok(())
 }
 
+/// Numbers the workload's particles at random by `seed` and, if `renumber`, then for
+/// locality; returns the new number of particle `tracked`.
+fn reorder(sim: &mut Simulation, (seed, renumber): (u64, bool), tracked: usize) -> usize {
+    let shuffled = Renumbering::shuffled(sim.particles().len(), &sim.bodies(), seed);
+    sim.renumber(&shuffled)
+        .expect("a shuffle within the bodies fits");
+    let mut at = shuffled.new_index(tracked);
+    if renumber {
+        at = sim.renumber_for_locality().new_index(at);
+    }
+    at
+}
+
+#[allow(clippy::too_many_arguments)]
 fn cloth(
     n: usize,
     steps: u64,
     integrator: Integrator,
     kernel: Option<Kernel>,
     air: bool,
+    order: Option<(u64, bool)>,
     json: bool,
 ) -> Result<ExitCode> {
     // Warm-up on a separate copy: page in the buffers and start the workers, so the measured
     // run starts from the workload's initial state.
     let mut warm = workload(n, steps, integrator, air)?;
     use_kernel(&mut warm.simulation, kernel)?;
+    if let Some(order) = order {
+        reorder(&mut warm.simulation, order, 0);
+    }
     warm.simulation.advance(steps.min(20))?;
     let mut scene = workload(n, steps, integrator, air)?;
     use_kernel(&mut scene.simulation, kernel)?;
+    let centre = match order {
+        Some(order) => reorder(&mut scene.simulation, order, workload::centre(n)),
+        None => workload::centre(n),
+    };
     let (times, seconds) = StepTimes::run(&mut scene.simulation, steps, |_| ())?;
     let springs = scene.simulation.model().springs.len();
     let triad_bytes_per_s = triad();
@@ -367,6 +405,8 @@ fn cloth(
         integrator: integrator.to_string(),
         kernel: scene.simulation.workspace().kernel().to_string(),
         air,
+        shuffle: order.map(|(seed, _)| seed),
+        renumbered: order.is_some_and(|(_, renumber)| renumber),
         springs,
         seconds,
         steps_per_s: steps as f64 / seconds,
@@ -374,7 +414,7 @@ fn cloth(
         median_step_s: times.median(),
         fastest_step_s: times.fastest(),
         median_spring_updates_per_s: springs as f64 / times.median(),
-        center_y: scene.simulation.particles().x[workload::centre(n)].y,
+        center_y: scene.simulation.particles().x[centre].y,
         triad_bytes_per_s,
         bytes_per_step,
         limit_steps_per_s,
@@ -384,12 +424,17 @@ fn cloth(
         println!("{}", serde_json::to_string(&figures)?);
     } else {
         println!(
-            "cloth N={n}{}: {springs} springs, {steps} {integrator} steps on {} threads ({} \
+            "cloth N={n}{}{}: {springs} springs, {steps} {integrator} steps on {} threads ({} \
              kernel) in {:.3} s: {:.1} steps/s, {:.1} M spring updates/s; median step {:.3} \
              ms ({:.1} M/s), fastest {:.3} ms; centre y = {:.12}\n  bandwidth: triad {:.1} GB/s, \
              a step moves at least {:.1} MB, so at most {:.1} steps/s; the median step runs at \
              {:.2} of that",
             if air { " in air" } else { "" },
+            match order {
+                Some((seed, true)) => format!(", shuffled by {seed} and renumbered"),
+                Some((seed, false)) => format!(", shuffled by {seed}"),
+                None => String::new(),
+            },
             figures.threads,
             figures.kernel,
             seconds,

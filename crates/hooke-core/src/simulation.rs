@@ -12,6 +12,7 @@ use crate::kernel::Kernel;
 use crate::model::{Attachment, Model};
 use crate::parallel;
 use crate::particles::{Particles, Vec3};
+use crate::renumber::Renumbering;
 use crate::stability::StabilityEstimate;
 
 /// A mass-spring system being simulated.
@@ -42,6 +43,22 @@ pub struct Simulation {
     /// stays on the calling thread instead of hopping onto a pool worker, which would cost
     /// more than the step.
     inline: bool,
+}
+
+/// Why [`Simulation::renumber`] refused a renumbering.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum RenumberError {
+    /// It numbers another count of particles.
+    #[error("a renumbering of {found} particles for a simulation of {expected}")]
+    Count {
+        /// The simulation's particles.
+        expected: usize,
+        /// The renumbering's.
+        found: usize,
+    },
+    /// It moves a particle out of its body's range.
+    #[error("a renumbering that moves particles between bodies")]
+    Body,
 }
 
 impl Simulation {
@@ -122,10 +139,63 @@ impl Simulation {
         self.contacts.stats
     }
 
-    /// Positions at the start of the last step, if the integrator saved them (every one
-    /// does except symplectic Euler on a model without a contact phase).
+    /// Positions at the start of the last step (every integrator keeps them; `None` before
+    /// the first step).
     pub fn start_positions(&self) -> Option<&[Vec3]> {
         self.workspace.start_positions(self.last)
+    }
+
+    /// The ranges of particles whose numbering a renumbering must keep to themselves: the
+    /// bodies with surfaces, or all particles as one range when there are none.
+    pub fn bodies(&self) -> Vec<std::ops::Range<usize>> {
+        if self.model.surfaces.is_empty() {
+            vec![0..self.particles.len()]
+        } else {
+            self.model
+                .surfaces
+                .iter()
+                .map(|s| s.particles.clone())
+                .collect()
+        }
+    }
+
+    /// Renumbers the particles and every index the model holds (see [`Renumbering`]):
+    /// the same physics, with particle `i` now `r.new_index(i)`. The solver's layout is
+    /// rebuilt and contact state starts afresh, as at step 0.
+    pub fn renumber(&mut self, r: &Renumbering) -> Result<(), RenumberError> {
+        if r.len() != self.particles.len() {
+            return Err(RenumberError::Count {
+                expected: self.particles.len(),
+                found: r.len(),
+            });
+        }
+        if !r.keeps(self.model.surfaces.iter().map(|s| s.particles.clone())) {
+            return Err(RenumberError::Body);
+        }
+        self.particles = r.particles(&self.particles);
+        r.model(&mut self.model);
+        let kernel = self.workspace.kernel;
+        self.workspace = Workspace {
+            kernel,
+            ..Workspace::default()
+        };
+        self.workspace.ensure(&self.model, self.particles.len());
+        self.contacts = ContactState::new(self.particles.len());
+        self.last = StepReport {
+            saved_start: false,
+            verdict: None,
+        };
+        Ok(())
+    }
+
+    /// Renumbers the particles of each body in an order with locality
+    /// ([`Renumbering::by_locality`]) and returns the renumbering, to map particle numbers
+    /// the caller holds.
+    pub fn renumber_for_locality(&mut self) -> Renumbering {
+        let r = Renumbering::by_locality(&self.particles.x, &self.model.springs, &self.bodies());
+        self.renumber(&r)
+            .expect("a body-keeping renumbering of these particles");
+        r
     }
 
     /// The integrator in use.
