@@ -149,7 +149,7 @@ impl Simulation {
     /// bodies with surfaces, or all particles as one range when there are none.
     pub fn bodies(&self) -> Vec<std::ops::Range<usize>> {
         if self.model.surfaces.is_empty() {
-            vec![0..self.particles.len()]
+            std::iter::once(0..self.particles.len()).collect()
         } else {
             self.model
                 .surfaces
