@@ -179,7 +179,23 @@ struct RenderArgs {
     view: image_out::View,
 }
 
+/// Leaves quietly, as a Unix filter does, when the reader of standard output has gone
+/// (`hooke bench cloth | head -1`): `println!` panics on a closed pipe, and this hook turns
+/// that panic into the status of a process killed by SIGPIPE (128 + 13) without a
+/// backtrace. Every other panic goes to the default hook.
+fn quiet_on_closed_pipe() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let message = info.payload_as_str().unwrap_or_default();
+        if message.starts_with("failed printing to stdout") && message.contains("os error 32") {
+            std::process::exit(141);
+        }
+        default(info);
+    }));
+}
+
 fn main() -> ExitCode {
+    quiet_on_closed_pipe();
     let cli = Cli::parse();
     hooke_cli::interrupt::install();
     // Everything but the window runs on a worker of the thread pool: the solver's parallel

@@ -461,3 +461,16 @@ fn an_obj_export_writes_a_frame_file_per_frame_with_named_objects() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A reader that goes away early (`hooke bench cloth | head -1`) ends the program as a
+/// closed pipe ends a Unix filter, status 141, without a panic's message or backtrace.
+#[test]
+fn a_closed_pipe_ends_the_program_quietly() {
+    let dir = scratch("closed-pipe");
+    let mut child = spawn(&["bench", "cloth", "--n", "32", "--steps", "400"], &dir);
+    // Close the read end before the figures are printed.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(141), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("panicked"), "{}", stderr(&out));
+}
