@@ -262,7 +262,7 @@ fn scatter_partition(
         macro_rules! runs {
             ($rest:expr) => {
                 RunArgs {
-                    runs,
+                    springs: runs,
                     rest: $rest,
                     param: &table.param,
                     params,
@@ -295,7 +295,7 @@ fn scatter_partition(
     macro_rules! args {
         ($rest:expr) => {
             ScatterArgs {
-                ends,
+                springs: ends,
                 rest: $rest,
                 param,
                 params,

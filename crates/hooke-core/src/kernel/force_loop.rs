@@ -53,7 +53,7 @@ pub(crate) const LANES: usize = 64;
 #[inline(always)]
 pub(crate) fn scatter_springs<const UNIFORM: bool, R: RestLookup, B: SpringBatch<LANES>>(
     ScatterArgs {
-        ends,
+        springs: ends,
         rest,
         param,
         params,
@@ -108,13 +108,16 @@ pub(crate) fn scatter_springs<const UNIFORM: bool, R: RestLookup, B: SpringBatch
     force[current - lo] += pull;
 }
 
-/// The arguments of [`scatter_springs`] for one partition.
-pub(crate) struct ScatterArgs<'a, R> {
-    /// The springs' ends, lower end first.
-    pub ends: &'a [[u32; 2]],
-    /// Their rest lengths.
+/// The arguments of a force loop for one partition: [`scatter_springs`]'s, whose springs
+/// are end pairs, or `super::run_loop::scatter_runs`'s, whose springs come in runs.
+pub(crate) struct ScatterArgs<'a, R, S = &'a [[u32; 2]]> {
+    /// The springs: their ends, lower end first, or runs of them.
+    pub springs: S,
+    /// Their rest lengths: from the first of `springs` for end pairs, by assembly index
+    /// for runs (whose `first` indexes them).
     pub rest: R,
-    /// Each spring's index into `params` (empty when every spring has `params[0]`).
+    /// Each spring's index into `params`, indexed as `rest` (empty when every spring has
+    /// `params[0]`).
     pub param: &'a [u32],
     /// The distinct `(ks, kd)` pairs.
     pub params: &'a [[f64; 2]],

@@ -14,7 +14,6 @@
 //! layout throughout.
 
 use super::force_loop::RestLookup;
-use crate::particles::Vec3;
 use crate::spring::spring_formula;
 
 /// Lower ends per chunk of runs: the layout cuts runs where their lower ends cross a
@@ -44,24 +43,7 @@ pub(crate) struct Run {
 }
 
 /// The arguments of [`scatter_runs`] for one partition.
-pub(crate) struct RunArgs<'a, R> {
-    /// The partition's runs.
-    pub runs: &'a [Run],
-    /// Rest lengths, by assembly spring index.
-    pub rest: R,
-    /// Each spring's index into `params`, by assembly index (empty when uniform).
-    pub param: &'a [u32],
-    /// The distinct `(ks, kd)` pairs.
-    pub params: &'a [[f64; 2]],
-    /// The window's first particle.
-    pub lo: usize,
-    /// The window's forces, particle `lo + k` at `k`.
-    pub force: &'a mut [Vec3],
-    /// Positions.
-    pub x: &'a [Vec3],
-    /// Velocities.
-    pub v: &'a [Vec3],
-}
+pub(crate) type RunArgs<'a, R> = super::ScatterArgs<'a, R, &'a [Run]>;
 
 /// A chunk's lower ends in component layout, read once per chunk, and the forces of its
 /// pieces, one row per offset (pieces of one offset cover distinct lower ends), kept until
@@ -135,7 +117,7 @@ pub(crate) fn group_by_lane(g: Group) {
 #[inline(always)]
 pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup>(
     RunArgs {
-        runs,
+        springs: runs,
         rest,
         param,
         params,
