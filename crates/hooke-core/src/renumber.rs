@@ -10,6 +10,11 @@ use crate::particles::{Particles, Vec3};
 use crate::spring::Spring;
 use std::ops::Range;
 
+/// The part of `range` below `n` (a body range past the particles names none of them).
+fn within(range: &Range<usize>, n: usize) -> Range<usize> {
+    range.start.min(n)..range.end.min(n)
+}
+
 /// A renumbering of `n` particles: particle `old` becomes `new_index(old)`.
 ///
 /// ```
@@ -66,7 +71,7 @@ impl Renumbering {
         };
         let mut order: Vec<u32> = (0..n as u32).collect();
         for body in bodies {
-            let part = &mut order[body.clone()];
+            let part = &mut order[within(body, n)];
             for k in (1..part.len()).rev() {
                 part.swap(k, (next() % (k as u64 + 1)) as usize);
             }
@@ -83,6 +88,7 @@ impl Renumbering {
     pub fn by_locality(x: &[Vec3], springs: &[Spring], bodies: &[Range<usize>]) -> Self {
         let mut order: Vec<u32> = (0..x.len() as u32).collect();
         for body in bodies {
+            let body = &within(body, x.len());
             let mut rest: Vec<f64> = springs
                 .iter()
                 .filter(|s| body.contains(&(s.i as usize)) && body.contains(&(s.j as usize)))
@@ -240,6 +246,13 @@ mod tests {
                 kind: crate::SpringKind::Other,
             })
             .collect();
+        // Ranges past the particles are cut at their end, not a panic.
+        let past = [1000..1200, 1300..1400];
+        assert_eq!(Renumbering::shuffled(4, &past, 1), Renumbering::identity(4));
+        assert_eq!(
+            Renumbering::by_locality(&x[..4], &[], &past),
+            Renumbering::identity(4)
+        );
         let shuffled = Renumbering::shuffled(x.len(), &bodies, 11);
         assert!(shuffled.keeps(bodies.iter().cloned()));
         assert_ne!(shuffled, Renumbering::identity(x.len()));
