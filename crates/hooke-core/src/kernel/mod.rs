@@ -232,11 +232,20 @@ mod tests {
 
     #[test]
     fn every_kernel_gives_the_same_bits() {
-        // Over 65536 distinct rest lengths are stored per spring instead of indexed.
-        for (uniform, count) in [(true, 20_000), (false, 20_000), (true, 70_000)] {
+        // Rest lengths are stored per spring for 20k springs (a small system), indexed for
+        // 40k (random lengths, all distinct), and per spring again for 70k (over 65536
+        // distinct ones).
+        let cases = [
+            (true, 20_000),
+            (false, 20_000),
+            (false, 40_000),
+            (true, 70_000),
+        ];
+        for (uniform, count) in cases {
             let (x, v, springs) = jumble(uniform, count);
             let forces = |kernel: Kernel| {
                 let mut asm = Assembly::new(x.len(), &springs);
+                assert_eq!(asm.rest_indexed(), count == 40_000, "{count} springs");
                 asm.set_kernel(kernel);
                 assert_eq!(asm.kernel(), kernel);
                 asm.scatter(&x, &v);
