@@ -3,7 +3,7 @@
 
 use crate::common::{builtin, root};
 use hooke_collide::table::round;
-use hooke_collide::{Cylinder, Placement, Plane};
+use hooke_collide::{BoxInterior, Cylinder, Placement, Plane};
 use hooke_core::{
     Collider, ColliderSlot, Integrator, Model, Particles, Response, Simulation, Vec3,
 };
@@ -267,4 +267,73 @@ fn implicit_cloth_stays_on_the_table_at_twenty_times_the_symplectic_step() {
         lowest > 0.3,
         "the edges hang, they do not fall: lowest y = {lowest}"
     );
+}
+
+/// `may_touch` is a promise the force loop relies on to skip colliders: wherever a plane or
+/// the box says a box of particles cannot touch it, no point of that box (its corners and
+/// random points inside) has a contact at that margin or any smaller one. Boxes are
+/// random, from far clear to straddling a wall; the promise must be made for many of them
+/// (or skipping would save nothing) and refused for every box holding a touching point.
+#[test]
+fn a_collider_that_says_a_box_is_clear_has_no_contact_in_it() {
+    let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let centre = Vec3::new(0.1, 0.2, 0.3);
+    let shapes: Vec<Box<dyn Collider>> = vec![
+        Box::new(Plane::ground(-1.0)),
+        Box::new(Plane::inclined([1.0, 2.0, -1.5, 0.7], &centre).unwrap()),
+        Box::new(Plane::inclined([-1.0, -2.0, 1.5, -0.7], &centre).unwrap()),
+        Box::new(Plane::inclined([0.0, 0.0, 3.0, 1.0], &centre).unwrap()),
+        Box::new(BoxInterior::jello()),
+        Box::new(BoxInterior {
+            min: Vec3::new(-2.5, -1.0, -2.0),
+            max: Vec3::new(2.0, 2.5, 2.75),
+        }),
+    ];
+    for shape in &shapes {
+        let (mut clear, mut touching) = (0, 0);
+        for _ in 0..4000 {
+            let lo = Vec3::new(next(), next(), next()) * 6.0 - Vec3::repeat(3.0);
+            let hi = lo + Vec3::new(next(), next(), next()) * next();
+            let margin = [0.0, 0.01, 0.2][(next() * 3.0) as usize];
+            let corners = (0..8).map(|k| {
+                Vec3::new(
+                    if k & 4 == 0 { lo.x } else { hi.x },
+                    if k & 2 == 0 { lo.y } else { hi.y },
+                    if k & 1 == 0 { lo.z } else { hi.z },
+                )
+            });
+            let inside =
+                (0..24).map(|_| lo + (hi - lo).component_mul(&Vec3::new(next(), next(), next())));
+            let mut touches = false;
+            for p in corners.chain(inside) {
+                for m in [0.0, 0.5 * margin, margin] {
+                    shape.contacts_within(&p, m, &mut |_| touches = true);
+                }
+            }
+            if shape.may_touch(&lo, &hi, margin) {
+                touching += usize::from(touches);
+            } else {
+                assert!(
+                    !touches,
+                    "{shape:?} promised {lo:?}..{hi:?} clear at {margin}"
+                );
+                clear += 1;
+            }
+        }
+        assert!(
+            clear > 400 && touching > 400,
+            "{shape:?}: {clear} clear, {touching} touching"
+        );
+        let nan = Vec3::new(f64::NAN, 0.0, 0.0);
+        assert!(
+            shape.may_touch(&nan, &nan, 0.0),
+            "{shape:?} promised a NaN box clear"
+        );
+    }
 }

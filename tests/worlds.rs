@@ -6,9 +6,9 @@ use crate::scenes::trajectory_report;
 use hooke_scene::world::{World, load_world, parse_world};
 use std::path::Path;
 
-const WORLDS: [&str; 5] = ["jello", "gravity", "moveLeft", "rotate", "skewedCorner"];
+pub(crate) const WORLDS: [&str; 5] = ["jello", "gravity", "moveLeft", "rotate", "skewedCorner"];
 
-fn world(name: &str) -> World {
+pub(crate) fn world(name: &str) -> World {
     load_world(&root().join(format!("assets/worlds/{name}.w"))).unwrap()
 }
 

@@ -92,6 +92,27 @@ impl Collider for Plane {
         }
     }
 
+    fn may_touch(&self, lo: &Vec3, hi: &Vec3, margin: f64) -> bool {
+        // The side's distance, a sum of products in a fixed order, is monotone in each
+        // coordinate as rounded too: its least over the box is at the corner chosen by
+        // the coefficients' signs, and no particle in the box is nearer than that corner.
+        let [a, b, c, _] = self.coefficients;
+        let pick = |k: f64, lo: f64, hi: f64| if self.side * k >= 0.0 { lo } else { hi };
+        let corner = Vec3::new(
+            pick(a, lo.x, hi.x),
+            pick(b, lo.y, hi.y),
+            pick(c, lo.z, hi.z),
+        );
+        let sf = self.side * self.f(&corner);
+        // Written so that NaN answers `true`.
+        let clear = if margin == 0.0 {
+            sf >= 0.0
+        } else {
+            sf / self.norm() >= margin
+        };
+        !clear
+    }
+
     fn contacts_within(&self, p: &Vec3, margin: f64, sink: &mut dyn FnMut(Contact)) {
         if margin == 0.0 {
             return self.contacts(p, sink);

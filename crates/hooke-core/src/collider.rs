@@ -65,6 +65,17 @@ pub trait Collider: Debug + Send + Sync {
         });
     }
 
+    /// Whether some point of the box `lo..hi` may have a contact within `margin` (with
+    /// [`Collider::contacts_within`], or [`Collider::contacts`] for a zero margin, at any
+    /// margin up to `margin`). `false` promises that no point of the box has one, so
+    /// callers may skip asking for every particle in it; the default never promises.
+    /// Shapes that answer must do so in the same arithmetic as their contact tests, so that
+    /// the promise holds to the last bit, and must answer `true` for a box with NaN bounds.
+    fn may_touch(&self, lo: &Vec3, hi: &Vec3, margin: f64) -> bool {
+        let _ = (lo, hi, margin);
+        true
+    }
+
     /// Calls `sink` with every sharp [`Feature`] of the surface that may lie in the box
     /// `lo..hi` (more is allowed, fewer is not). Smooth shapes (planes, the box interior,
     /// whose edges are concave from the free side) have none, the default.

@@ -61,7 +61,7 @@ pub use excerpt::excerpt;
 pub use force_field::{FIELD_HALF_EXTENT, ForceField};
 pub use integrator::{Integrator, StepReport, Sym3, UnknownIntegrator, Workspace};
 pub use kernel::{Kernel, UnknownKernel};
-pub use model::{Attachment, ColliderSlot, Model};
+pub use model::{Attachment, ColliderSlot, Model, Near};
 pub use number::Num;
 pub use particles::{Particles, SANE_BOUND, Vec3};
 pub use renumber::Renumbering;

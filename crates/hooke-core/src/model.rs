@@ -60,6 +60,22 @@ pub struct Attachment {
     pub kd: f64,
 }
 
+/// Which of a model's penalty colliders may touch a group of particles (see
+/// [`Model::near`]): bit `k` for collider `k`; colliders past the 64th are always asked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Near(u64);
+
+impl Near {
+    /// Every collider may touch.
+    pub const ALL: Self = Self(u64::MAX);
+
+    /// Whether collider `k` may touch.
+    #[inline]
+    pub fn may_touch(self, k: usize) -> bool {
+        k >= 64 || self.0 >> k & 1 == 1
+    }
+}
+
 /// Particles per parallel block of collision responses.
 const CONTACT_BLOCK: usize = 256;
 
@@ -101,7 +117,19 @@ impl Model {
     /// forces: external forces, attachments and springs.
     #[inline]
     pub fn total_force(&self, p: usize, mass: f64, x: &Vec3, v: &Vec3, springs: Vec3) -> Vec3 {
-        let f = self.external_force(p, mass, x, v) + springs;
+        self.total_force_near(p, (mass, x, v), springs, Near::ALL)
+    }
+
+    /// [`Model::total_force`] asking only the penalty colliders `near` may let touch.
+    #[inline]
+    pub fn total_force_near(
+        &self,
+        p: usize,
+        (mass, x, v): (f64, &Vec3, &Vec3),
+        springs: Vec3,
+        near: Near,
+    ) -> Vec3 {
+        let f = self.external_force_near(p, mass, x, v, near) + springs;
         if self.attachments.is_empty() {
             f
         } else {
@@ -109,10 +137,61 @@ impl Model {
         }
     }
 
+    /// The penalty colliders that may touch some particle at positions `x`: those whose
+    /// [`Collider::may_touch`] holds for the particles' bounding box, at the largest contact
+    /// thickness of any surface. Forces computed with the answer are the same bits as
+    /// without it; only the colliders' answers for particles they cannot touch are skipped.
+    pub fn near(&self, x: &[Vec3]) -> Near {
+        if self.colliders.iter().all(|c| !c.response.is_force()) {
+            return Near::ALL;
+        }
+        // Component by component: nalgebra's `inf`/`sup` cost three times as much here.
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for p in x {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        let (lo, hi) = (Vec3::from(lo), Vec3::from(hi));
+        let margin = self
+            .surfaces
+            .iter()
+            .map(|s| s.thickness)
+            .fold(0.0, f64::max);
+        let mut bits = u64::MAX;
+        for (k, slot) in self.colliders.iter().enumerate().take(64) {
+            if slot.response.is_force() && !slot.shape.may_touch(&lo, &hi, margin) {
+                bits &= !(1 << k);
+            }
+        }
+        Near(bits)
+    }
+
+    /// Whether gravity is the only force besides the springs on particles whose penalty
+    /// colliders are `near` (see [`Model::gravity_only`]): then [`Model::total_force_near`]
+    /// is `m g + springs`, to the bit.
+    pub fn gravity_only_near(&self, near: Near) -> bool {
+        self.field.is_none()
+            && self.drag == 0.0
+            && self.attachments.is_empty()
+            && self
+                .colliders
+                .iter()
+                .enumerate()
+                .all(|(k, c)| !c.response.is_force() || !near.may_touch(k))
+    }
+
     /// Every force on particle `p` except its springs': gravity, field, drag, penalties (with
     /// the particle's contact thickness as the penalty springs' margin).
     #[inline]
     pub fn external_force(&self, p: usize, mass: f64, x: &Vec3, v: &Vec3) -> Vec3 {
+        self.external_force_near(p, mass, x, v, Near::ALL)
+    }
+
+    /// [`Model::external_force`] asking only the penalty colliders `near` may let touch.
+    #[inline]
+    pub fn external_force_near(&self, p: usize, mass: f64, x: &Vec3, v: &Vec3, near: Near) -> Vec3 {
         let mut f = self.gravity * mass;
         if let Some(field) = &self.field {
             f += field.sample(x);
@@ -121,8 +200,8 @@ impl Model {
             f -= v * self.drag;
         }
         let mut margin = None;
-        for slot in &self.colliders {
-            if slot.response.is_force() {
+        for (k, slot) in self.colliders.iter().enumerate() {
+            if slot.response.is_force() && near.may_touch(k) {
                 let m = *margin.get_or_insert_with(|| self.margin(p));
                 slot.shape.contacts_within(x, m, &mut |c: Contact| {
                     f += slot.response.penalty_force(&c, v)

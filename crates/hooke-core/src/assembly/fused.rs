@@ -30,7 +30,11 @@ impl<F: Fn(usize, &[Vec3], &mut [Vec3], &mut [Vec3]) -> bool + Sync> Finish for 
 
 /// Adds into `out` (particles `start..`, zeroed first) the windows of `parts` that hold
 /// them, in the order given.
-fn sum_windows<'a>(parts: impl Iterator<Item = &'a Partition>, start: usize, out: &mut [Vec3]) {
+pub(super) fn sum_windows<'a>(
+    parts: impl Iterator<Item = &'a Partition>,
+    start: usize,
+    out: &mut [Vec3],
+) {
     out.fill(Vec3::zeros());
     let end = start + out.len();
     for part in parts {
@@ -104,7 +108,7 @@ impl<F: Finish> Pass<'_, F> {
 }
 
 /// The tables a partition's scatter reads.
-type Layout<'a> = (
+pub(super) type Layout<'a> = (
     &'a super::SpringTable,
     &'a [super::Run],
     crate::kernel::Kernel,

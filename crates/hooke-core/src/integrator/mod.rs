@@ -225,19 +225,6 @@ impl Workspace {
     }
 }
 
-/// `a = F(x, v, t) / m` with the workspace's assembly and air forces.
-fn accelerations(
-    model: &Model,
-    (assembly, air): (&mut Assembly, &mut AirForces),
-    p: &Particles,
-    (x, v): (&[Vec3], &[Vec3]),
-    t: f64,
-    a: &mut [Vec3],
-) {
-    let extra = air.evaluate(model, x, v, t);
-    assembly.accelerations(model, (&p.mass, &p.inv_mass), (x, v), extra, a);
-}
-
 /// Per-particle updates in parallel blocks of [`BLOCK`] particles.
 fn for_blocks(
     a: &mut [Vec3],
@@ -245,22 +232,4 @@ fn for_blocks(
     f: impl Fn(usize, &mut [Vec3], &mut [Vec3]) + Sync + Send,
 ) {
     parallel::for_blocks(BLOCK, a, b, f);
-}
-
-/// The trial state `(xt, vt) = (x + c·kx, v + c·kv)` of a multi-stage scheme.
-#[allow(clippy::too_many_arguments)]
-fn trial(
-    (x, v): (&[Vec3], &[Vec3]),
-    (kx, kv): (&[Vec3], &[Vec3]),
-    c: f64,
-    xt: &mut [Vec3],
-    vt: &mut [Vec3],
-) {
-    for_blocks(xt, vt, |start, xt, vt| {
-        for k in 0..xt.len() {
-            let i = start + k;
-            xt[k] = x[i] + kx[i] * c;
-            vt[k] = v[i] + kv[i] * c;
-        }
-    });
 }

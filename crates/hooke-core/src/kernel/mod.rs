@@ -172,7 +172,7 @@ fn runs_avx512<const UNIFORM: bool, R: RestLookup>(args: RunArgs<R>) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::assembly::Assembly;
     use crate::particles::Vec3;
@@ -180,7 +180,7 @@ mod tests {
 
     /// A deterministic jumble of particles and `count` springs: random ends, lengths from 0
     /// (a degenerate spring) to far stretched, and several `(ks, kd)` pairs or just one.
-    fn jumble(uniform: bool, count: usize) -> (Vec<Vec3>, Vec<Vec3>, Vec<Spring>) {
+    pub(crate) fn jumble(uniform: bool, count: usize) -> (Vec<Vec3>, Vec<Vec3>, Vec<Spring>) {
         let mut seed = 0x2545_f491_4f6c_dd1d_u64;
         let mut next = move || {
             seed ^= seed << 13;
