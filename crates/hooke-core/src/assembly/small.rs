@@ -21,7 +21,7 @@ use super::fused::sum_windows;
 use super::{Assembly, Partition, REDUCE_BLOCK, scatter_partition};
 use crate::particles::Vec3;
 use std::ops::Range;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Mutex, OnceLock};
 use std::time::Instant;
 
@@ -39,6 +39,16 @@ pub(super) struct Balance {
     /// The first particle of each group's range, then the particle count (fractional, so
     /// that small corrections accumulate).
     cut: Vec<f64>,
+}
+
+/// Raises its flag if dropped, which only unwinding does (the scatter it guards forgets it
+/// when it returns).
+struct Unwinding<'a>(&'a AtomicBool);
+
+impl Drop for Unwinding<'_> {
+    fn drop(&mut self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
 }
 
 /// What one group measured: when it finished (ns after the pass began) and how long its
@@ -69,6 +79,8 @@ struct Pass<'a, F> {
     unclaimed: &'a [Mutex<Option<&'a mut Partition>>],
     /// Each partition's window once scattered.
     published: &'a [OnceLock<&'a Partition>],
+    /// Set when a scatter panicked, so that threads waiting for its window stop.
+    failed: AtomicBool,
     /// The first partition of each group, then the partition count.
     first: [usize; MAX_PARTS + 1],
     /// The first particle of each group's range, then the particle count.
@@ -88,17 +100,23 @@ impl<'a, F: Finish3> Pass<'a, F> {
             if let Some(part) = self.published[q].get() {
                 return part;
             }
-            // A poisoned lock means a scatter panicked; the panic is on its way here.
             if let Ok(mut slot) = self.unclaimed[q].try_lock()
                 && let Some(part) = slot.take()
             {
                 drop(slot);
                 let (x, v) = self.state;
+                let unwinding = Unwinding(&self.failed);
                 scatter_partition(self.layout, part, x, v);
+                std::mem::forget(unwinding);
                 let part: &'a Partition = part;
                 let _ = self.published[q].set(part);
                 return part;
             }
+            // Its window will never come: let rayon carry the scatter's panic out.
+            assert!(
+                !self.failed.load(Ordering::Relaxed),
+                "a partition's scatter panicked on another thread"
+            );
             // A window is usually published within a few microseconds, sooner than a
             // sleep and wake-up would take.
             if spins < SPINS {
@@ -276,6 +294,7 @@ impl Assembly {
             extent,
             unclaimed: &unclaimed,
             published: &published,
+            failed: AtomicBool::new(false),
             first,
             cut,
             state: (x, v),
@@ -297,6 +316,7 @@ mod tests {
     use crate::model::{ColliderSlot, Model};
     use crate::particles::Vec3;
     use crate::response::Response;
+    use crate::spring::{Spring, SpringKind};
 
     /// A penalty floor at height `y` that answers [`Collider::may_touch`].
     #[derive(Debug)]
@@ -401,6 +421,55 @@ mod tests {
                     assert!(!sane, "{case}: particle 1234's block reported insane");
                 }
             }
+        }
+    }
+
+    /// A scatter that panics (here: positions for all particles but the last, a caller's
+    /// bug that only the second partition's springs reach) fails the pass on every thread
+    /// count, instead of leaving the thread that needs its window waiting for it.
+    #[test]
+    fn a_panicking_scatter_fails_the_pass_instead_of_hanging_it() {
+        let n = 3000;
+        let spring = |i: usize, j: usize| Spring {
+            i: i as u32,
+            j: j as u32,
+            rest: 0.1,
+            ks: 100.0,
+            kd: 0.5,
+            kind: SpringKind::Other,
+        };
+        let springs: Vec<Spring> = (0..n - 1)
+            .map(|i| spring(i, i + 1))
+            .chain((0..n - 200).map(|i| spring(i, i + 200)))
+            .collect();
+        let model = Model {
+            springs: springs.clone(),
+            ..Model::default()
+        };
+        let (x, mass) = (vec![Vec3::zeros(); n], vec![1.0; n]);
+        for threads in 1..=3 {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut asm = Assembly::new(n, &springs);
+            let (mut a, mut o1, mut o2) = (x.clone(), x.clone(), x.clone());
+            let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                pool.install(|| {
+                    let short = (&x[..n - 1], &x[..n - 1]);
+                    let out = (&mut o1[..], &mut o2[..]);
+                    asm.accelerations_then(
+                        &model,
+                        (&mass, &mass),
+                        short,
+                        &[],
+                        &mut a,
+                        out,
+                        |_, _, _, _| true,
+                    )
+                })
+            }));
+            assert!(result.is_err(), "{threads} threads");
         }
     }
 }
