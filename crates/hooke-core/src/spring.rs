@@ -228,9 +228,10 @@ impl<const L: usize> SpringBatch<L> for ComponentBatch<L> {
 
 /// `L` springs with each vector stored whole: filling and emptying the batch takes one
 /// vector store or load per 3-vector instead of three scalars, and the compiler
-/// deinterleaves in the vector loop. The fastest layout with AVX-512, whose two-source
+/// deinterleaves in the vector loop. Faster with AVX-512 on some CPUs, whose two-source
 /// permutes make that cheap (cloth-256 on a Zen 5, 1 thread: 188 → 201 M spring
-/// updates/s against [`ComponentBatch`]).
+/// updates/s against [`ComponentBatch`]), slower on others (a `jello.w` step on a Zen 4:
+/// 150 µs against 104 µs): the AVX-512 kernel times both (`kernel/batch_choice.rs`).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct VectorBatch<const L: usize> {
     d: [[f64; 3]; L],

@@ -4,15 +4,18 @@
 //! division per spring, whose throughput per instruction is the same for 1, 2, 4 or 8
 //! lanes on current x86 cores: wider vectors are nearly free speed. Portable builds target
 //! baseline x86-64 (2 lanes), so the loop is compiled again for AVX2 and AVX-512 and the
-//! widest the CPU supports is picked at run time, each with the batch layout it runs
-//! fastest with (`ComponentBatch` or `VectorBatch`, see `spring.rs`). This is the
-//! workspace's one use of `unsafe`: calling a function compiled for features that were
+//! widest the CPU supports is picked at run time. Portable and AVX2 builds batch springs
+//! by component (`ComponentBatch`, see `spring.rs`); the AVX-512 build times both layouts
+//! once per process and keeps the faster (`batch_choice.rs`). This module is the
+//! workspace's one use of `unsafe`: calling functions compiled for features that were
 //! checked to be present.
 
+mod batch_choice;
 mod force_loop;
 mod run_avx2;
 mod run_loop;
 
+pub(crate) use batch_choice::BatchLayout;
 pub(crate) use force_loop::{RestLookup, ScatterArgs};
 pub(crate) use run_loop::{MAX_OFFSETS, RUN_CHUNK, Run, RunArgs};
 
@@ -85,6 +88,24 @@ impl Kernel {
         }
     }
 
+    /// How this kernel's per-spring loop batches springs: `"component"` (one array per
+    /// component) or `"vector"` (each vector whole). The AVX-512 kernel times both once per
+    /// process on first use and keeps the faster; the others always batch by component.
+    /// Both give the same bits.
+    #[allow(unsafe_code)]
+    pub fn batches(self) -> &'static str {
+        let layout = match self.min(Self::detect()) {
+            // SAFETY: the kernel is at most `detect()`, which checked AVX-512's features.
+            #[cfg(target_arch = "x86_64")]
+            Self::Avx512 => unsafe { batch_choice::avx512_layout() },
+            _ => BatchLayout::Component,
+        };
+        match layout {
+            BatchLayout::Component => "component",
+            BatchLayout::Vector => "vector",
+        }
+    }
+
     /// Runs the spring force loop compiled for this kernel.
     #[allow(unsafe_code)]
     pub(crate) fn scatter<const UNIFORM: bool, R: RestLookup>(self, args: ScatterArgs<R>) {
@@ -97,9 +118,27 @@ impl Kernel {
             #[cfg(target_arch = "x86_64")]
             Self::Avx2 => unsafe { scatter_avx2::<UNIFORM, R>(args) },
             #[cfg(target_arch = "x86_64")]
-            Self::Avx512 => unsafe { scatter_avx512::<UNIFORM, R>(args) },
+            Self::Avx512 => unsafe {
+                scatter_avx512::<UNIFORM, R>(batch_choice::avx512_layout(), args)
+            },
             #[cfg(not(target_arch = "x86_64"))]
             _ => scatter_springs::<UNIFORM, R, ComponentBatch<LANES>>(args),
+        }
+    }
+
+    /// [`Kernel::scatter`] with the AVX-512 loop's batch layout given, for tests of both.
+    #[cfg(test)]
+    #[allow(unsafe_code)]
+    pub(crate) fn scatter_with<const UNIFORM: bool, R: RestLookup>(
+        self,
+        layout: BatchLayout,
+        args: ScatterArgs<R>,
+    ) {
+        match self.min(Self::detect()) {
+            // SAFETY: as in `scatter`.
+            #[cfg(target_arch = "x86_64")]
+            Self::Avx512 => unsafe { scatter_avx512::<UNIFORM, R>(layout, args) },
+            other => other.scatter::<UNIFORM, R>(args),
         }
     }
 }
@@ -150,11 +189,14 @@ fn scatter_avx2<const UNIFORM: bool, R: RestLookup>(args: ScatterArgs<R>) {
     scatter_springs::<UNIFORM, R, ComponentBatch<LANES>>(args);
 }
 
-/// The spring force loop compiled for AVX-512.
+/// The spring force loop compiled for AVX-512, with batches in `layout`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx2")]
-fn scatter_avx512<const UNIFORM: bool, R: RestLookup>(args: ScatterArgs<R>) {
-    scatter_springs::<UNIFORM, R, VectorBatch<LANES>>(args);
+fn scatter_avx512<const UNIFORM: bool, R: RestLookup>(layout: BatchLayout, args: ScatterArgs<R>) {
+    match layout {
+        BatchLayout::Component => scatter_springs::<UNIFORM, R, ComponentBatch<LANES>>(args),
+        BatchLayout::Vector => scatter_springs::<UNIFORM, R, VectorBatch<LANES>>(args),
+    }
 }
 
 /// The run loop compiled for AVX2.
@@ -281,6 +323,45 @@ pub(crate) mod tests {
                     "{kernel} differs from portable ({count}, uniform: {uniform})"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn both_avx512_batch_layouts_give_the_portable_bits() {
+        // The process keeps one layout, timed on this CPU: each is run here by name. On a
+        // CPU without AVX-512 both runs are the widest kernel it has.
+        let (x, v, springs) = jumble(false, 20_000);
+        let mut ends: Vec<[u32; 2]> = springs
+            .iter()
+            .map(|s| [s.i.min(s.j), s.i.max(s.j)])
+            .collect();
+        ends.sort();
+        let rest: Vec<f64> = springs.iter().map(|s| s.rest).collect();
+        let params: Vec<[f64; 2]> = vec![[100.0, 0.25], [200.0, 0.5], [300.0, 0.0]];
+        let param: Vec<u32> = (0..ends.len() as u32).map(|k| k % 3).collect();
+        let forces = |kernel: Kernel, layout: BatchLayout| {
+            let mut f = vec![Vec3::zeros(); x.len()];
+            kernel.scatter_with::<false, _>(
+                layout,
+                ScatterArgs {
+                    springs: &ends[..],
+                    rest: &rest[..],
+                    param: &param,
+                    params: &params,
+                    lo: 0,
+                    force: &mut f,
+                    x: &x,
+                    v: &v,
+                },
+            );
+            f.iter()
+                .flat_map(|f| f.iter().map(|c| c.to_bits()))
+                .collect::<Vec<u64>>()
+        };
+        let portable = forces(Kernel::Portable, BatchLayout::Component);
+        assert!(portable.iter().any(|&b| b != 0), "the springs pull");
+        for layout in [BatchLayout::Component, BatchLayout::Vector] {
+            assert!(forces(Kernel::Avx512, layout) == portable, "{layout:?}");
         }
     }
 
