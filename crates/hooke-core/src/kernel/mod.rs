@@ -13,6 +13,7 @@
 mod batch_choice;
 mod force_loop;
 mod run_avx2;
+mod run_avx512;
 mod run_loop;
 
 pub(crate) use batch_choice::BatchLayout;
@@ -21,7 +22,7 @@ pub(crate) use run_loop::{MAX_OFFSETS, RUN_CHUNK, Run, RunArgs};
 
 use crate::spring::{ComponentBatch, VectorBatch};
 use force_loop::{LANES, scatter_springs};
-use run_loop::{group_by_lane, scatter_runs};
+use run_loop::{GROUP, group_by_lane, scatter_runs};
 use std::fmt;
 use std::str::FromStr;
 
@@ -148,14 +149,14 @@ impl Kernel {
     #[allow(unsafe_code)]
     pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup>(self, args: RunArgs<R>) {
         match self.min(Self::detect()) {
-            Self::Portable => scatter_runs::<UNIFORM, R>(args, group_by_lane),
+            Self::Portable => scatter_runs::<UNIFORM, R, GROUP>(args, group_by_lane),
             // SAFETY: as in `scatter`.
             #[cfg(target_arch = "x86_64")]
             Self::Avx2 => unsafe { runs_avx2::<UNIFORM, R>(args) },
             #[cfg(target_arch = "x86_64")]
             Self::Avx512 => unsafe { runs_avx512::<UNIFORM, R>(args) },
             #[cfg(not(target_arch = "x86_64"))]
-            _ => scatter_runs::<UNIFORM, R>(args, group_by_lane),
+            _ => scatter_runs::<UNIFORM, R, GROUP>(args, group_by_lane),
         }
     }
 }
@@ -203,14 +204,14 @@ fn scatter_avx512<const UNIFORM: bool, R: RestLookup>(layout: BatchLayout, args:
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn runs_avx2<const UNIFORM: bool, R: RestLookup>(args: RunArgs<R>) {
-    scatter_runs::<UNIFORM, R>(args, |g| run_avx2::group_avx2(g));
+    scatter_runs::<UNIFORM, R, GROUP>(args, |g| run_avx2::group_avx2(g));
 }
 
-/// The run loop compiled for AVX-512.
+/// The run loop compiled for AVX-512, eight springs per group.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx2")]
 fn runs_avx512<const UNIFORM: bool, R: RestLookup>(args: RunArgs<R>) {
-    scatter_runs::<UNIFORM, R>(args, |g| run_avx2::group_avx2(g));
+    scatter_runs::<UNIFORM, R, { run_avx512::WIDE }>(args, |g| run_avx512::group_avx512(g));
 }
 
 #[cfg(test)]

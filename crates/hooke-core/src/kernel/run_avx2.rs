@@ -60,9 +60,10 @@ fn transpose_out([x, y, z]: [__m256d; 3]) -> [f64; 3 * GROUP] {
 /// [`super::run_loop::group_by_lane`] in AVX2 registers.
 #[target_feature(enable = "avx2")]
 #[inline]
-pub(crate) fn group_avx2(g: Group) {
-    let xb = transpose_in(g.xb);
-    let vb = transpose_in(g.vb);
+pub(crate) fn group_avx2(g: Group<GROUP>) {
+    let flat = |p: &[[f64; 3]; GROUP]| -> [f64; 3 * GROUP] { bytemuck::cast(*p) };
+    let xb = transpose_in(&flat(g.xb));
+    let vb = transpose_in(&flat(g.vb));
     let d: [__m256d; 3] = std::array::from_fn(|c| _mm256_sub_pd(load(g.x[c]), xb[c]));
     let dv: [__m256d; 3] = std::array::from_fn(|c| _mm256_sub_pd(load(g.v[c]), vb[c]));
     let sq = |v: __m256d| _mm256_mul_pd(v, v);
@@ -85,7 +86,7 @@ pub(crate) fn group_avx2(g: Group) {
     for (c, keep) in g.keep.into_iter().enumerate() {
         *keep = store(f[c]);
     }
-    let out = transpose_in(g.out);
+    let out = transpose_in(&flat(g.out));
     let out: [__m256d; 3] = std::array::from_fn(|c| _mm256_sub_pd(out[c], f[c]));
-    *g.out = transpose_out(out);
+    *g.out = bytemuck::cast(transpose_out(out));
 }

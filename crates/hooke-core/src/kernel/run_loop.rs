@@ -7,11 +7,14 @@
 //! row by row (grids, extruded shapes, the jelly) are mostly runs; [`crate::Assembly`] finds
 //! them and leaves the rest to [`super::force_loop`].
 //!
-//! Springs go four at a time: the AVX2 kernel loads four upper ends' coordinates as twelve
-//! consecutive values, transposes them in registers, computes the four forces in one
-//! instruction per operation and transposes them back (`run_avx2.rs`); the portable
-//! kernel does the same lane by lane. The lower ends of a chunk of runs sit in component
-//! layout throughout.
+//! Springs go in groups of four (eight with AVX-512): the vector kernels load the upper
+//! ends' coordinates as consecutive values, transpose them in registers, compute the
+//! group's forces in one instruction per operation and transpose them back (`run_avx2.rs`,
+//! `run_avx512.rs`); the portable kernel does the same lane by lane. The lower ends of a
+//! chunk of runs sit in component layout throughout. The group's width is the vector's:
+//! on a core that issues a 512-bit operation at half the rate of a 256-bit one, eight
+//! springs per instruction still halve the instructions waiting on each square root and
+//! division, which is what bounds a group's overlap with the next.
 
 use super::force_loop::RestLookup;
 use crate::spring::spring_formula;
@@ -20,7 +23,7 @@ use crate::spring::spring_formula;
 /// multiple of it, and the loop handles one chunk's pieces together.
 pub(crate) const RUN_CHUNK: usize = 32;
 
-/// Springs computed together.
+/// Springs computed together by the portable and AVX2 kernels.
 pub(crate) const GROUP: usize = 4;
 
 /// The most distinct offsets the pieces of one chunk may have (the layout keeps partitions
@@ -56,52 +59,52 @@ struct Chunk {
     lower: [bool; RUN_CHUNK],
 }
 
-/// Four consecutive springs of a piece, as [`scatter_runs`] hands them to a group step.
-pub(crate) struct Group<'a> {
+/// `W` consecutive springs of a piece, as [`scatter_runs`] hands them to a group step.
+pub(crate) struct Group<'a, const W: usize> {
     /// The lower ends' positions and velocities, by component.
-    pub x: [&'a [f64; GROUP]; 3],
-    pub v: [&'a [f64; GROUP]; 3],
-    /// Where the step writes the four forces, by component.
-    pub keep: [&'a mut [f64; GROUP]; 3],
-    /// The upper ends' flat positions and velocities.
-    pub xb: &'a [f64; 3 * GROUP],
-    pub vb: &'a [f64; 3 * GROUP],
-    /// The upper ends' flat forces: the step subtracts each spring's force.
-    pub out: &'a mut [f64; 3 * GROUP],
+    pub x: [&'a [f64; W]; 3],
+    pub v: [&'a [f64; W]; 3],
+    /// Where the step writes the group's forces, by component.
+    pub keep: [&'a mut [f64; W]; 3],
+    /// The upper ends' positions and velocities.
+    pub xb: &'a [[f64; 3]; W],
+    pub vb: &'a [[f64; 3]; W],
+    /// The upper ends' forces: the step subtracts each spring's force.
+    pub out: &'a mut [[f64; 3]; W],
     /// Rest lengths, stiffnesses and dampings.
-    pub rest: [f64; GROUP],
-    pub ks: [f64; GROUP],
-    pub kd: [f64; GROUP],
+    pub rest: [f64; W],
+    pub ks: [f64; W],
+    pub kd: [f64; W],
 }
 
-/// Lanes `a..a + GROUP` of a chunk's row.
+/// Lanes `a..a + W` of a chunk's row.
 #[inline(always)]
-fn lanes(row: &[f64; RUN_CHUNK], a: usize) -> &[f64; GROUP] {
-    row[a..a + GROUP].try_into().expect("four lanes")
+fn lanes<const W: usize>(row: &[f64; RUN_CHUNK], a: usize) -> &[f64; W] {
+    row[a..a + W].try_into().expect("a group's lanes")
 }
 
-/// Lanes `a..a + GROUP` of a chunk's row, to write.
+/// Lanes `a..a + W` of a chunk's row, to write.
 #[inline(always)]
-fn lanes_mut(row: &mut [f64; RUN_CHUNK], a: usize) -> &mut [f64; GROUP] {
-    (&mut row[a..a + GROUP]).try_into().expect("four lanes")
+fn lanes_mut<const W: usize>(row: &mut [f64; RUN_CHUNK], a: usize) -> &mut [f64; W] {
+    (&mut row[a..a + W]).try_into().expect("a group's lanes")
 }
 
 /// The group step of the portable kernel: lane by lane with [`spring_formula`], the same
 /// operations in the same order as every other kernel's.
 #[inline(always)]
-pub(crate) fn group_by_lane(g: Group) {
-    for l in 0..GROUP {
-        let d = [0, 1, 2].map(|c| g.x[c][l] - g.xb[3 * l + c]);
-        let dv = [0, 1, 2].map(|c| g.v[c][l] - g.vb[3 * l + c]);
+pub(crate) fn group_by_lane<const W: usize>(g: Group<W>) {
+    for l in 0..W {
+        let d = [0, 1, 2].map(|c| g.x[c][l] - g.xb[l][c]);
+        let dv = [0, 1, 2].map(|c| g.v[c][l] - g.vb[l][c]);
         let f = spring_formula(d, dv, g.rest[l], g.ks[l], g.kd[l]);
         for (c, f) in f.into_iter().enumerate() {
             g.keep[c][l] = f;
-            g.out[3 * l + c] -= f;
+            g.out[l][c] -= f;
         }
     }
 }
 
-/// Adds the forces of every spring of `runs` into the window, four springs at a time
+/// Adds the forces of every spring of `runs` into the window, `W` springs at a time
 /// through `group` (which must compute [`group_by_lane`]'s bits), in exactly the sequence of
 /// the per-spring loop over the same springs in sorted order (`super::force_loop`): each
 /// particle first loses the forces of the springs it is the upper end of, by ascending
@@ -115,7 +118,7 @@ pub(crate) fn group_by_lane(g: Group) {
 /// end for any one upper end. The pieces' forces are kept, and once the chunk is done each
 /// lower end sums its pieces' by ascending offset and adds the sum to the window.
 #[inline(always)]
-pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup>(
+pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup, const W: usize>(
     RunArgs {
         springs: runs,
         rest,
@@ -126,10 +129,10 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup>(
         x,
         v,
     }: RunArgs<R>,
-    mut group: impl FnMut(Group),
+    mut group: impl FnMut(Group<W>),
 ) {
-    let (x, v): (&[f64], &[f64]) = (bytemuck::cast_slice(x), bytemuck::cast_slice(v));
-    let force: &mut [f64] = bytemuck::cast_slice_mut(force);
+    let (x, v): (&[[f64; 3]], &[[f64; 3]]) = (bytemuck::cast_slice(x), bytemuck::cast_slice(v));
+    let force: &mut [[f64; 3]] = bytemuck::cast_slice_mut(force);
     // On the stack (15 KiB): stepping allocates nothing.
     let mut chunk = Chunk {
         x: [[0.0; RUN_CHUNK]; 3],
@@ -157,14 +160,11 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup>(
         let last = pieces.iter().map(|r| r.lo + r.len).max().unwrap_or(0) as usize;
         let span = (last - first).min(RUN_CHUNK);
         let chunk = &mut chunk;
-        let (xs, vs) = (
-            &x[3 * first..3 * (first + span)],
-            &v[3 * first..3 * (first + span)],
-        );
+        let (xs, vs) = (&x[first..first + span], &v[first..first + span]);
         for c in 0..3 {
             for l in 0..span {
-                chunk.x[c][l] = xs[3 * l + c];
-                chunk.v[c][l] = vs[3 * l + c];
+                chunk.x[c][l] = xs[l][c];
+                chunk.v[c][l] = vs[l][c];
             }
         }
         // Zero where no piece of a row writes, so that every row adds in whole; a row's
@@ -183,8 +183,8 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup>(
             let n = (piece.len as usize).min(span - i);
             let j = piece.lo as usize + piece.offset as usize;
             let k = piece.first as usize;
-            let (xb, vb) = (&x[3 * j..3 * (j + n)], &v[3 * j..3 * (j + n)]);
-            let out = &mut force[3 * (j - lo)..3 * (j - lo + n)];
+            let (xb, vb) = (&x[j..j + n], &v[j..j + n]);
+            let out = &mut force[j - lo..j - lo + n];
             let rest = rest.slice(k..k + n);
             let param = if UNIFORM { &[][..] } else { &param[k..k + n] };
             let ks_kd = |l: usize| {
@@ -196,38 +196,32 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup>(
             };
             let kept = &mut chunk.forces[q];
             let mut g = 0;
-            while g + GROUP <= n {
+            while g + W <= n {
                 let a = i + g;
                 let [f0, f1, f2] = &mut *kept;
-                let pairs: [[f64; 2]; GROUP] = std::array::from_fn(|l| ks_kd(g + l));
+                let pairs: [[f64; 2]; W] = std::array::from_fn(|l| ks_kd(g + l));
                 group(Group {
                     x: [0, 1, 2].map(|c| lanes(&chunk.x[c], a)),
                     v: [0, 1, 2].map(|c| lanes(&chunk.v[c], a)),
                     keep: [lanes_mut(f0, a), lanes_mut(f1, a), lanes_mut(f2, a)],
-                    xb: xb[3 * g..3 * (g + GROUP)]
-                        .try_into()
-                        .expect("twelve values"),
-                    vb: vb[3 * g..3 * (g + GROUP)]
-                        .try_into()
-                        .expect("twelve values"),
-                    out: (&mut out[3 * g..3 * (g + GROUP)])
-                        .try_into()
-                        .expect("twelve values"),
+                    xb: xb[g..g + W].try_into().expect("a group's ends"),
+                    vb: vb[g..g + W].try_into().expect("a group's ends"),
+                    out: (&mut out[g..g + W]).try_into().expect("a group's ends"),
                     rest: std::array::from_fn(|l| rest.rest(g + l)),
                     ks: pairs.map(|p| p[0]),
                     kd: pairs.map(|p| p[1]),
                 });
-                g += GROUP;
+                g += W;
             }
             for l in g..n {
                 let a = i + l;
-                let dx = [0, 1, 2].map(|c| chunk.x[c][a] - xb[3 * l + c]);
-                let dv = [0, 1, 2].map(|c| chunk.v[c][a] - vb[3 * l + c]);
+                let dx = [0, 1, 2].map(|c| chunk.x[c][a] - xb[l][c]);
+                let dv = [0, 1, 2].map(|c| chunk.v[c][a] - vb[l][c]);
                 let [ks, kd] = ks_kd(l);
                 let f = spring_formula(dx, dv, rest.rest(l), ks, kd);
                 for c in 0..3 {
                     kept[c][a] = f[c];
-                    out[3 * l + c] -= f[c];
+                    out[l][c] -= f[c];
                 }
             }
         }
@@ -246,11 +240,11 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup>(
             let n = (piece.len as usize).min(span - i);
             chunk.lower[i..i + n].fill(true);
         }
-        let out = &mut force[3 * (first - lo)..3 * (first - lo + span)];
-        for l in 0..span {
-            if chunk.lower[l] {
-                for c in 0..3 {
-                    out[3 * l + c] += chunk.pull[c][l];
+        let out = &mut force[first - lo..first - lo + span];
+        for (l, (out, lower)) in out.iter_mut().zip(chunk.lower).enumerate() {
+            if lower {
+                for (c, out) in out.iter_mut().enumerate() {
+                    *out += chunk.pull[c][l];
                 }
             }
         }
