@@ -23,6 +23,9 @@ use crate::spring::spring_formula;
 /// multiple of it, and the loop handles one chunk's pieces together.
 pub(crate) const RUN_CHUNK: usize = 32;
 
+/// Lower ends whose pulls are summed together, in one register with AVX-512.
+const PULL_LANES: usize = 8;
+
 /// Springs computed together by the portable and AVX2 kernels.
 pub(crate) const GROUP: usize = 4;
 
@@ -55,7 +58,6 @@ struct Chunk {
     x: [[f64; RUN_CHUNK]; 3],
     v: [[f64; RUN_CHUNK]; 3],
     forces: [[[f64; RUN_CHUNK]; 3]; MAX_OFFSETS],
-    pull: [[f64; RUN_CHUNK]; 3],
     lower: [bool; RUN_CHUNK],
 }
 
@@ -138,7 +140,6 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup, const W: usize>(
         x: [[0.0; RUN_CHUNK]; 3],
         v: [[0.0; RUN_CHUNK]; 3],
         forces: [[[0.0; RUN_CHUNK]; 3]; MAX_OFFSETS],
-        pull: [[0.0; RUN_CHUNK]; 3],
         lower: [false; RUN_CHUNK],
     };
     let mut start = 0;
@@ -168,10 +169,23 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup, const W: usize>(
             }
         }
         // Zero where no piece of a row writes, so that every row adds in whole; a row's
-        // zeros add nothing to a pull, which starts at +0 and so is never -0.
-        for row in &mut chunk.forces[..rows] {
-            for c in row.iter_mut() {
-                c[..span].fill(0.0);
+        // zeros add nothing to a pull, which starts at +0 and so is never -0. Pieces of one
+        // row cover distinct lower ends, so a row whose pieces hold `span` springs in all is
+        // written whole and needs none (most rows of a mesh built row by row).
+        let mut covered = [0usize; MAX_OFFSETS];
+        let mut q = 0;
+        for (p, piece) in pieces.iter().enumerate() {
+            if p > 0 && piece.offset != pieces[p - 1].offset {
+                q += 1;
+            }
+            let i = piece.lo as usize - first;
+            covered[q] += (piece.len as usize).min(span - i);
+        }
+        for (row, &covered) in chunk.forces[..rows].iter_mut().zip(&covered) {
+            if covered < span {
+                for c in row.iter_mut() {
+                    c[..span].fill(0.0);
+                }
             }
         }
         let mut q = 0;
@@ -225,26 +239,38 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup, const W: usize>(
                 }
             }
         }
-        // Each lower end's pull: its pieces' forces by ascending offset, from zero.
-        for c in 0..3 {
-            chunk.pull[c][..span].fill(0.0);
-            for row in chunk.forces[..rows].iter().rev() {
-                for (p, f) in chunk.pull[c][..span].iter_mut().zip(&row[c][..span]) {
-                    *p += f;
-                }
-            }
-        }
         chunk.lower[..span].fill(false);
         for piece in pieces {
             let i = piece.lo as usize - first;
             let n = (piece.len as usize).min(span - i);
             chunk.lower[i..i + n].fill(true);
         }
+        // Each lower end's pull: its pieces' forces by ascending offset, from zero, added to
+        // the window. Eight lanes at a time the sum stays in one register across the rows.
+        let rows = &chunk.forces[..rows];
         let out = &mut force[first - lo..first - lo + span];
-        for (l, (out, lower)) in out.iter_mut().zip(chunk.lower).enumerate() {
-            if lower {
-                for (c, out) in out.iter_mut().enumerate() {
-                    *out += chunk.pull[c][l];
+        let whole = span / PULL_LANES * PULL_LANES;
+        for c in 0..3 {
+            for a in (0..whole).step_by(PULL_LANES) {
+                let mut pull = [0.0; PULL_LANES];
+                for row in rows.iter().rev() {
+                    for (p, f) in pull.iter_mut().zip(&row[c][a..a + PULL_LANES]) {
+                        *p += f;
+                    }
+                }
+                for (k, p) in pull.into_iter().enumerate() {
+                    if chunk.lower[a + k] {
+                        out[a + k][c] += p;
+                    }
+                }
+            }
+            for l in whole..span {
+                if chunk.lower[l] {
+                    let mut pull = 0.0;
+                    for row in rows.iter().rev() {
+                        pull += row[c][l];
+                    }
+                    out[l][c] += pull;
                 }
             }
         }
