@@ -204,8 +204,9 @@ pub struct Assembly {
 /// each a lower end, an offset and its springs, in the order the run loop takes them: by
 /// chunk of [`RUN_CHUNK`] lower ends, then by offset from the largest. `None` when the
 /// partition is better or only correctly served by the per-spring loop: short pieces, a
-/// chunk with pieces of more than [`MAX_OFFSETS`] offsets, or a spring given twice (whose two forces the
-/// sorted order adds in the model's order, which pieces do not keep).
+/// chunk with pieces of more than [`MAX_OFFSETS`] offsets, or a spring given twice (whose
+/// two forces the sorted order adds in the model's order, which pieces do not keep; the
+/// run loop also relies on pieces of one offset covering distinct lower ends).
 fn pieces(
     springs: &[Spring],
     sorted: &[u32],
