@@ -164,8 +164,8 @@ fn every_force_kernel_gives_the_same_trajectory() {
 /// instead of a separate scan: the first bad step must still be the one reported. At 40×
 /// the stable step the workload blows up within some steps; the state one step before
 /// the reported one is sane, and the reported particle is the first bad one. The step
-/// writes its new state beside the old, which it keeps as the start positions: they must
-/// be the previous step's positions to the bit, and the report's step-size estimate, made
+/// updates the state in place, copying the positions aside as the start positions: they
+/// must be the previous step's positions to the bit, and the report's step-size estimate, made
 /// from them, the one at the actual start.
 #[test]
 fn symplectic_reports_the_first_diverged_step_and_particle() {

@@ -425,7 +425,7 @@ fn cloth(
     } else {
         println!(
             "cloth N={n}{}{}: {springs} springs, {steps} {integrator} steps on {} threads ({} \
-             kernel, {} batches) in {:.3} s: {:.1} steps/s, {:.1} M spring updates/s; median step {:.3} \
+             kernel, {} batches, runs by {}) in {:.3} s: {:.1} steps/s, {:.1} M spring updates/s; median step {:.3} \
              ms ({:.1} M/s), fastest {:.3} ms; centre y = {:.12}\n  bandwidth: triad {:.1} GB/s, \
              a step moves at least {:.1} MB, so at most {:.1} steps/s; the median step runs at \
              {:.2} of that",
@@ -438,6 +438,7 @@ fn cloth(
             figures.threads,
             figures.kernel,
             scene.simulation.workspace().kernel().batches(),
+            scene.simulation.workspace().kernel().run_lanes(),
             seconds,
             figures.steps_per_s,
             figures.spring_updates_per_s / 1e6,
@@ -496,7 +497,7 @@ fn scene_steps(
     } else {
         println!(
             "{}: {} particles, {} springs, {steps} {} steps of {} s on {} threads ({} kernel, \
-             {} batches) in {:.3} s: {:.0} steps/s (median step {:.1} µs, fastest {:.1} µs), {:.3} s per \
+             {} batches, runs by {}) in {:.3} s: {:.0} steps/s (median step {:.1} µs, fastest {:.1} µs), {:.3} s per \
              simulated second; contacts {:.0}% of the time ({} candidate rebuilds){}",
             figures.scene,
             figures.particles,
@@ -506,6 +507,7 @@ fn scene_steps(
             figures.threads,
             figures.kernel,
             sim.workspace().kernel().batches(),
+            sim.workspace().kernel().run_lanes(),
             seconds,
             figures.steps_per_s,
             figures.median_step_s * 1e6,

@@ -14,7 +14,7 @@
 mod fused;
 mod small;
 
-use crate::kernel::{Kernel, MAX_OFFSETS, RUN_CHUNK, Run, RunArgs, ScatterArgs};
+use crate::kernel::{Kernel, MAX_OFFSETS, RUN_CHUNK, Run, RunArgs, ScatterArgs, Window};
 use crate::model::{Model, Near};
 use crate::parallel;
 use crate::particles::Vec3;
@@ -151,8 +151,57 @@ struct Partition {
     runs: Range<usize>,
     /// The first particle of the window.
     lo: usize,
-    /// One force per particle of the window `lo..lo + force.len()`.
-    force: Vec<Vec3>,
+    /// The window's length: it covers particles `lo..lo + len`.
+    len: usize,
+    /// The window's buffer: the forces by component, each component's in one of three
+    /// equal thirds (its first `len` entries), so that the run loop adds a group of
+    /// springs' forces with whole vectors and no transposition. Its thirds are as long as
+    /// the longest window where windows are of about one length, so that the one-pass step
+    /// can hand a buffer still in cache from one partition to another (see `fused.rs`).
+    force: Vec<f64>,
+}
+
+impl Partition {
+    /// Particles the buffer can hold.
+    fn capacity(&self) -> usize {
+        self.force.len() / 3
+    }
+
+    /// The window by component: the forces on particles `lo..lo + len`.
+    fn window(&self) -> [&[f64]; 3] {
+        let third = self.capacity();
+        [0, 1, 2].map(|c| &self.force[c * third..c * third + self.len])
+    }
+
+    /// The window, to write.
+    fn window_mut(&mut self) -> Window<'_> {
+        let (third, len) = (self.capacity(), self.len);
+        let (x, rest) = self.force.split_at_mut(third);
+        let (y, z) = rest.split_at_mut(third);
+        [&mut x[..len], &mut y[..len], &mut z[..len]]
+    }
+
+    /// Adds the window's forces on particles `start..start + out.len()` (where they meet it)
+    /// to `out`.
+    fn add_to(&self, start: usize, out: &mut [Vec3]) {
+        let (lo, hi) = (self.lo.max(start), self.hi().min(start + out.len()));
+        if lo < hi {
+            let [x, y, z] = self.window().map(|c| &c[lo - self.lo..hi - self.lo]);
+            for (k, o) in out[lo - start..hi - start].iter_mut().enumerate() {
+                *o += Vec3::new(x[k], y[k], z[k]);
+            }
+        }
+    }
+
+    /// One past the window's last particle.
+    fn hi(&self) -> usize {
+        self.lo + self.len
+    }
+
+    /// The stretch of `(x, v)` the window covers: what [`scatter_partition`] reads.
+    fn read<'a>(&self, (x, v): (&'a [Vec3], &'a [Vec3])) -> (&'a [Vec3], &'a [Vec3]) {
+        (&x[self.lo..self.hi()], &v[self.lo..self.hi()])
+    }
 }
 
 /// The fewest springs per piece, on average, for a partition to be laid out as runs: below
@@ -267,18 +316,22 @@ fn pieces(
     Some(pieces)
 }
 
-/// Computes the forces of `part`'s springs at `(x, v)` into its window.
+/// Computes the forces of `part`'s springs at `(x, v)`, the state of the window's particles
+/// (see [`Partition::read`]), into its window.
 fn scatter_partition(
     (table, runs, kernel): (&SpringTable, &[Run], Kernel),
     part: &mut Partition,
     x: &[Vec3],
     v: &[Vec3],
 ) {
-    part.force.fill(Vec3::zeros());
+    let (lo, springs, pieces) = (part.lo, part.springs.clone(), part.runs.clone());
+    let mut force = part.window_mut();
+    for c in &mut force {
+        c.fill(0.0);
+    }
     let uniform = table.param.is_empty();
-    let (lo, force) = (part.lo, &mut part.force[..]);
     let params = &table.params[..];
-    let runs = &runs[part.runs.clone()];
+    let runs = &runs[pieces];
     if !runs.is_empty() {
         macro_rules! runs {
             ($rest:expr) => {
@@ -288,7 +341,7 @@ fn scatter_partition(
                     param: &table.param,
                     params,
                     lo,
-                    force: &mut *force,
+                    force: force.each_mut().map(|c| &mut **c),
                     x,
                     v,
                 }
@@ -306,7 +359,7 @@ fn scatter_partition(
         }
         return;
     }
-    let r = part.springs.clone();
+    let r = springs;
     let ends = &table.ends[r.clone()];
     let param = if uniform {
         &[][..]
@@ -390,11 +443,13 @@ impl Assembly {
             match min_average.and_then(|min| pieces(springs, &order[range.clone()], min)) {
                 Some(pieces) => {
                     for (lo, offset, members) in pieces {
+                        let rest = |&k: &u32| springs[k as usize].rest.to_bits();
                         runs.push(Run {
                             lo,
                             offset,
                             len: members.len() as u32,
                             first: table.ends.len() as u32,
+                            same_rest: members.iter().all(|k| rest(k) == rest(&members[0])),
                         });
                         for k in members {
                             push(&mut table, k);
@@ -414,8 +469,18 @@ impl Assembly {
                 springs: range,
                 runs: first_run..runs.len(),
                 lo,
-                force: vec![Vec3::zeros(); hi + 1 - lo],
+                len: hi + 1 - lo,
+                force: Vec::new(),
             });
+        }
+        let longest = partitions.iter().map(|p| p.len).max().unwrap_or(0);
+        let total: usize = partitions.iter().map(|p| p.len).sum();
+        // Buffers of one length let every window use any buffer; when that would cost more
+        // than half again the windows' own memory (windows of very unequal reach), each
+        // keeps its own length and only buffers that fit trade places.
+        let even = 2 * longest * partitions.len() <= 3 * total;
+        for part in &mut partitions {
+            part.force = vec![0.0; 3 * if even { longest } else { part.len }];
         }
         if table.params.len() == 1 {
             table.param = Vec::new();
@@ -427,7 +492,7 @@ impl Assembly {
         for b in 0..blocks {
             let (lo, hi) = (b * REDUCE_BLOCK, ((b + 1) * REDUCE_BLOCK).min(particles));
             for (k, part) in partitions.iter().enumerate() {
-                if part.lo < hi && part.lo + part.force.len() > lo {
+                if part.lo < hi && part.hi() > lo {
                     block_parts.push(k as u32);
                 }
             }
@@ -483,6 +548,7 @@ impl Assembly {
     pub fn scatter(&mut self, x: &[Vec3], v: &[Vec3]) {
         let layout = (&self.table, &self.runs[..], self.kernel);
         each_partition(&mut self.partitions, |part| {
+            let (x, v) = part.read((x, v));
             scatter_partition(layout, part, x, v)
         });
     }
@@ -494,14 +560,19 @@ impl Assembly {
     pub fn scatter_pairs(&mut self, g: impl Fn(usize, usize, usize) -> Vec3 + Sync) {
         let table = &self.table;
         let scatter = |part: &mut Partition| {
-            part.force.fill(Vec3::zeros());
-            let lo = part.lo;
-            for k in part.springs.clone() {
+            let (lo, springs) = (part.lo, part.springs.clone());
+            let mut window = part.window_mut();
+            for c in &mut window {
+                c.fill(0.0);
+            }
+            for k in springs {
                 let [i, j] = table.ends[k];
                 let (i, j) = (i as usize, j as usize);
                 let f = g(k, i, j);
-                part.force[i - lo] += f;
-                part.force[j - lo] -= f;
+                for (c, w) in window.iter_mut().enumerate() {
+                    w[i - lo] += f[c];
+                    w[j - lo] -= f[c];
+                }
             }
         };
         each_partition(&mut self.partitions, scatter);
@@ -543,16 +614,8 @@ impl Assembly {
     pub(crate) fn gather_block(&self, start: usize, out: &mut [Vec3]) {
         debug_assert!(start.is_multiple_of(REDUCE_BLOCK) && out.len() <= REDUCE_BLOCK);
         out.fill(Vec3::zeros());
-        let end = start + out.len();
         for &q in self.block_parts(start / REDUCE_BLOCK) {
-            let part = &self.partitions[q as usize];
-            let (lo, hi) = (part.lo.max(start), (part.lo + part.force.len()).min(end));
-            if lo < hi {
-                let window = &part.force[lo - part.lo..hi - part.lo];
-                for (o, f) in out[lo - start..hi - start].iter_mut().zip(window) {
-                    *o += f;
-                }
-            }
+            self.partitions[q as usize].add_to(start, out);
         }
     }
 

@@ -106,6 +106,7 @@ impl<'a, F: Finish3> Pass<'a, F> {
                 drop(slot);
                 let (x, v) = self.state;
                 let unwinding = Unwinding(&self.failed);
+                let (x, v) = part.read((x, v));
                 scatter_partition(self.layout, part, x, v);
                 std::mem::forget(unwinding);
                 let part: &'a Partition = part;
@@ -279,7 +280,7 @@ impl Assembly {
         let cut = self.balance.cuts(groups, self.particles);
         let mut extent: [Range<usize>; MAX_PARTS] = Default::default();
         for (e, part) in extent.iter_mut().zip(&self.partitions) {
-            *e = part.lo..part.lo + part.force.len();
+            *e = part.lo..part.hi();
         }
         let unclaimed: [Mutex<Option<&mut Partition>>; MAX_PARTS] = Default::default();
         for (slot, part) in unclaimed.iter().zip(self.partitions.iter_mut()) {

@@ -2,8 +2,8 @@
 //!
 //! The spring forces, their sums, the update and the divergence check are one pass over the
 //! partitions and particles ([`crate::Assembly`]'s `scatter_and_finish`): the method that
-//! benchmarks run streams each array about once per step. The new state is written beside
-//! the old one, whose positions then serve as the start positions.
+//! benchmarks run streams each array about once per step. The state is updated in place,
+//! and the start positions are copied aside as it goes.
 
 use super::{StepReport, Workspace};
 use crate::model::Model;
@@ -31,9 +31,10 @@ pub(super) fn step(
 }
 
 /// The step; with `GRAVITY_ONLY` (see [`Model::gravity_only`]) the external force is
-/// `m g`, without the general per-particle tests. The new state goes to the workspace's
-/// spare arrays, which then trade places with the particles' (so the old positions become
-/// the start positions, at no cost). Returns whether the state it wrote is sane.
+/// `m g`, without the general per-particle tests. The state is updated in place, each
+/// stretch's positions copied to the workspace's start positions first: the contact phase
+/// and a divergence report read them (positions rebuilt as `x - v dt` would lose their
+/// digits exactly where a step blew up). Returns whether the state it wrote is sane.
 fn update<const GRAVITY_ONLY: bool>(
     model: &Model,
     p: &mut Particles,
@@ -41,15 +42,13 @@ fn update<const GRAVITY_ONLY: bool>(
     ws: &mut Workspace,
 ) -> bool {
     let air = ws.air.evaluate(model, &p.x, &p.v, t);
-    let (x, v) = (&p.x[..], &p.v[..]);
     let (mass, inv_mass) = (&p.mass[..], &p.inv_mass[..]);
-    let finish = |start: usize, springs: &[Vec3], xn: &mut [Vec3], vn: &mut [Vec3]| {
-        let n = springs.len().min(xn.len()).min(vn.len());
-        let (x, v) = (&x[start..start + n], &v[start..start + n]);
+    let finish = |start: usize, springs: &[Vec3], x: &mut [Vec3], v: &mut [Vec3]| {
+        let n = springs.len().min(x.len()).min(v.len());
         let (mass, inv_mass) = (&mass[start..start + n], &inv_mass[start..start + n]);
         for k in 0..n {
+            // A pinned particle keeps its state.
             if inv_mass[k] == 0.0 {
-                (xn[k], vn[k]) = (x[k], v[k]);
                 continue;
             }
             let f = if GRAVITY_ONLY {
@@ -63,16 +62,11 @@ fn update<const GRAVITY_ONLY: bool>(
                 };
                 model.total_force(start + k, mass[k], &x[k], &v[k], pairwise)
             };
-            vn[k] = v[k] + f * inv_mass[k] * dt;
-            xn[k] = x[k] + vn[k] * dt;
+            v[k] += f * inv_mass[k] * dt;
+            x[k] += v[k] * dt;
         }
-        parallel::sane(&xn[..n], &vn[..n], SANE_BOUND)
+        parallel::sane(&x[..n], &v[..n], SANE_BOUND)
     };
-    let sane = ws
-        .assembly
-        .scatter_and_finish((x, v), (&mut ws.xt, &mut ws.vt), finish);
-    std::mem::swap(&mut p.x, &mut ws.xt);
-    std::mem::swap(&mut ws.xt, &mut ws.x0);
-    std::mem::swap(&mut p.v, &mut ws.vt);
-    sane
+    ws.assembly
+        .scatter_and_finish((&mut p.x, &mut p.v), &mut ws.x0, finish)
 }

@@ -1,13 +1,19 @@
-//! Which batch layout the AVX-512 per-spring loop uses, chosen by timing both on this CPU.
+//! Which batch layout the AVX-512 per-spring loop uses, and how many springs its run loop
+//! takes per group, each chosen by timing both on this CPU.
 //!
 //! The two layouts (see `crate::spring`) give the same bits, but which is faster depends
 //! on the microarchitecture, by more than a rule on the instruction set can capture:
 //! `VectorBatch` ran cloth-256 7 % faster than `ComponentBatch` on a Zen 5, while on a Zen 4
 //! it made a `jello.w` RK4 step 40 % slower (median 150 µs against 104 µs, 2 threads).
 //! So the first AVX-512 scatter of a process times both on a small mesh-like system and
-//! keeps the faster for the rest of the process. The choice changes speed, never a result.
+//! keeps the faster for the rest of the process. The run loop's groups likewise: eight
+//! springs in 512-bit registers or four in 256-bit ones, which on an Intel Xeon with
+//! AVX-512 ran cloth-1024 about 5 % faster (two 256-bit operations issue where one 512-bit
+//! one does, and the square root and division cost no more per lane). The choices change
+//! speed, never a result.
 
 use super::force_loop::{LANES, ScatterArgs, scatter_springs};
+use super::run_loop::{Run, RunArgs};
 use crate::particles::Vec3;
 use crate::spring::{ComponentBatch, SpringBatch, VectorBatch};
 use std::sync::OnceLock;
@@ -60,7 +66,7 @@ unsafe fn faster_layout() -> BatchLayout {
         .filter(|&[_, j]| (j as usize) < PARTICLES)
         .collect();
     let rest = vec![0.1; ends.len()];
-    let mut force = vec![Vec3::zeros(); PARTICLES];
+    let mut force = vec![0.0; 3 * PARTICLES];
     let mut pass = |layout: BatchLayout| {
         let args = ScatterArgs {
             springs: &ends[..],
@@ -68,7 +74,11 @@ unsafe fn faster_layout() -> BatchLayout {
             param: &[],
             params: &[[1000.0, 0.01]],
             lo: 0,
-            force: &mut force[..],
+            force: {
+                let (x, rest) = force.split_at_mut(PARTICLES);
+                let (y, z) = rest.split_at_mut(PARTICLES);
+                [x, y, z]
+            },
             x: &x,
             v: &v,
         };
@@ -100,4 +110,141 @@ unsafe fn faster_layout() -> BatchLayout {
 #[target_feature(enable = "avx512f,avx512vl,avx2")]
 fn timed<B: SpringBatch<LANES>>(args: ScatterArgs<&[f64]>) {
     scatter_springs::<true, &[f64], B>(args);
+}
+
+/// How many springs the AVX-512 run loop computes per group.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum RunWidth {
+    /// Eight, in 512-bit registers.
+    Eight,
+    /// Four, in 256-bit registers (the AVX2 kernel's group).
+    Four,
+}
+
+/// The run loop's group width in this process: measured on first use.
+///
+/// # Safety
+/// The CPU must support AVX-512F, AVX-512VL and AVX2 (`super::Kernel::detect`).
+#[allow(unsafe_code)]
+pub(crate) unsafe fn avx512_run_width() -> RunWidth {
+    static CHOICE: OnceLock<RunWidth> = OnceLock::new();
+    // SAFETY: passed on from the caller.
+    *CHOICE.get_or_init(|| unsafe { faster_run_width() })
+}
+
+/// The timed grid: rows of this many particles, and as many rows.
+const SIDE: usize = 64;
+
+/// A `SIDE × SIDE` cloth's structural, shear and bend springs as the layout hands them to
+/// the run loop (24k springs, all in L2): cut at chunks of lower ends, by chunk and then by
+/// offset from the largest; and its particles' positions and velocities, jittered by `seed`.
+fn run_grid(seed: u64) -> (Vec<Run>, Vec<Vec3>, Vec<Vec3>) {
+    use super::run_loop::RUN_CHUNK;
+    let n = SIDE * SIDE;
+    let mut seed = seed | 1;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let x: Vec<Vec3> = (0..n)
+        .map(|p| Vec3::new((p % SIDE) as f64 + next(), (p / SIDE) as f64, next()) * 0.1)
+        .collect();
+    let v: Vec<Vec3> = (0..n).map(|_| Vec3::new(next(), next(), next())).collect();
+    let offsets = [2 * SIDE, SIDE + 1, SIDE, SIDE - 1, 2, 1];
+    let mut runs = Vec::new();
+    for lo in (0..n - 2 * SIDE - RUN_CHUNK).step_by(RUN_CHUNK) {
+        for offset in offsets {
+            runs.push(Run {
+                lo: lo as u32,
+                offset: offset as u32,
+                len: RUN_CHUNK as u32,
+                first: (runs.len() * RUN_CHUNK) as u32,
+                same_rest: true,
+            });
+        }
+    }
+    (runs, x, v)
+}
+
+/// The run loop over `runs` at `(x, v)` with groups of `width`, into `force` (by
+/// component, thirds of equal length).
+///
+/// # Safety
+/// The CPU must support AVX-512F, AVX-512VL and AVX2.
+#[allow(unsafe_code)]
+unsafe fn run_pass(width: RunWidth, runs: &[Run], (x, v): (&[Vec3], &[Vec3]), force: &mut [f64]) {
+    let n = x.len();
+    let (fx, fyz) = force.split_at_mut(n);
+    let (fy, fz) = fyz.split_at_mut(n);
+    let rest = vec![0.1; runs.iter().map(|r| r.len as usize).sum()];
+    let args = RunArgs {
+        springs: runs,
+        rest: &rest[..],
+        param: &[],
+        params: &[[1000.0, 0.01]],
+        lo: 0,
+        force: [fx, fy, fz],
+        x,
+        v,
+    };
+    // SAFETY: passed on from the caller.
+    unsafe {
+        match width {
+            RunWidth::Eight => super::runs_avx512_eight::<true, &[f64]>(args),
+            RunWidth::Four => super::runs_avx2::<true, &[f64]>(args),
+        }
+    }
+}
+
+/// Times both group widths on [`run_grid`], interleaved, and returns the one with the
+/// faster best pass.
+#[allow(unsafe_code)]
+unsafe fn faster_run_width() -> RunWidth {
+    let (runs, x, v) = run_grid(1);
+    let mut force = vec![0.0; 3 * x.len()];
+    let mut pass = |width: RunWidth| {
+        let start = Instant::now();
+        // SAFETY: passed on from the caller.
+        unsafe { run_pass(width, &runs, (&x, &v), &mut force) };
+        start.elapsed()
+    };
+    let mut best = [Duration::MAX; 2];
+    for _ in 0..9 {
+        best[0] = best[0].min(pass(RunWidth::Eight));
+        best[1] = best[1].min(pass(RunWidth::Four));
+    }
+    if best[1] < best[0] {
+        RunWidth::Four
+    } else {
+        RunWidth::Eight
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Both group widths of the AVX-512 run loop give the same bits, whichever this
+    /// process chose (on a CPU without AVX-512 there is nothing to compare).
+    #[test]
+    #[allow(unsafe_code)]
+    fn both_run_widths_give_the_same_bits() {
+        if super::super::Kernel::detect() < super::super::Kernel::Avx512 {
+            return;
+        }
+        for seed in [3, 17] {
+            let (runs, x, v) = run_grid(seed);
+            let forces = |width| {
+                let mut force = vec![0.0; 3 * x.len()];
+                // SAFETY: the CPU has AVX-512 (checked above).
+                unsafe { run_pass(width, &runs, (&x, &v), &mut force) };
+                force.iter().map(|f| f.to_bits()).collect::<Vec<u64>>()
+            };
+            let eight = forces(RunWidth::Eight);
+            assert!(eight.iter().any(|&f| f != 0), "the springs pull");
+            assert!(eight == forces(RunWidth::Four), "seed {seed}");
+        }
+    }
 }

@@ -38,6 +38,10 @@ impl RestLookup for (&[u16], &[f64]) {
     }
 }
 
+/// A partition's window of forces by component: `force[c][k]` is component `c` of the
+/// force on particle `lo + k`.
+pub(crate) type Window<'a> = [&'a mut [f64]; 3];
+
 /// Springs per batch of the force loop.
 pub(crate) const LANES: usize = 64;
 
@@ -84,9 +88,9 @@ pub(crate) fn scatter_springs<const UNIFORM: bool, R: RestLookup, B: SpringBatch
             // Consecutive springs mostly share their lower end: load it once per run.
             if i != lower {
                 lower = i;
-                (xi, vi) = (x[i], v[i]);
+                (xi, vi) = (x[i - lo], v[i - lo]);
             }
-            batch.set(l, &(xi - x[j]), &(vi - v[j]), rest.rest(l));
+            batch.set(l, &(xi - x[j - lo]), &(vi - v[j - lo]), rest.rest(l));
             if !UNIFORM {
                 let [ks, kd] = params[param[b * LANES + l] as usize];
                 batch.set_params(l, ks, kd);
@@ -97,15 +101,21 @@ pub(crate) fn scatter_springs<const UNIFORM: bool, R: RestLookup, B: SpringBatch
             let (i, j) = (i as usize, j as usize);
             let f = batch.force(l);
             if i != current {
-                force[current - lo] += pull;
+                for c in 0..3 {
+                    force[c][current - lo] += pull[c];
+                }
                 pull = Vec3::zeros();
                 current = i;
             }
             pull += f;
-            force[j - lo] -= f;
+            for c in 0..3 {
+                force[c][j - lo] -= f[c];
+            }
         }
     }
-    force[current - lo] += pull;
+    for c in 0..3 {
+        force[c][current - lo] += pull[c];
+    }
 }
 
 /// The arguments of a force loop for one partition: [`scatter_springs`]'s, whose springs
@@ -124,9 +134,9 @@ pub(crate) struct ScatterArgs<'a, R, S = &'a [[u32; 2]]> {
     /// The window's first particle.
     pub lo: usize,
     /// The window's forces, particle `lo + k` at `k`.
-    pub force: &'a mut [Vec3],
-    /// Positions.
+    pub force: Window<'a>,
+    /// The window's positions, particle `lo + k` at `k`.
     pub x: &'a [Vec3],
-    /// Velocities.
+    /// The window's velocities, as `x`.
     pub v: &'a [Vec3],
 }

@@ -17,7 +17,9 @@ mod run_avx512;
 mod run_loop;
 
 pub(crate) use batch_choice::BatchLayout;
-pub(crate) use force_loop::{RestLookup, ScatterArgs};
+#[cfg(target_arch = "x86_64")]
+use batch_choice::RunWidth;
+pub(crate) use force_loop::{RestLookup, ScatterArgs, Window};
 pub(crate) use run_loop::{MAX_OFFSETS, RUN_CHUNK, Run, RunArgs};
 
 use crate::spring::{ComponentBatch, VectorBatch};
@@ -89,6 +91,22 @@ impl Kernel {
         }
     }
 
+    /// How many springs this kernel's run loop computes per group: 4 for the portable
+    /// kernel (lane by lane) and AVX2, and 8 or 4 for AVX-512, which times both once per
+    /// process on first use and keeps the faster. Both give the same bits.
+    #[allow(unsafe_code)]
+    pub fn run_lanes(self) -> usize {
+        match self.min(Self::detect()) {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: the kernel is at most `detect()`, which checked AVX-512's features.
+            Self::Avx512 => match unsafe { batch_choice::avx512_run_width() } {
+                RunWidth::Eight => 8,
+                RunWidth::Four => 4,
+            },
+            _ => GROUP,
+        }
+    }
+
     /// How this kernel's per-spring loop batches springs: `"component"` (one array per
     /// component) or `"vector"` (each vector whole). The AVX-512 kernel times both once per
     /// process on first use and keeps the faster; the others always batch by component.
@@ -154,7 +172,12 @@ impl Kernel {
             #[cfg(target_arch = "x86_64")]
             Self::Avx2 => unsafe { runs_avx2::<UNIFORM, R>(args) },
             #[cfg(target_arch = "x86_64")]
-            Self::Avx512 => unsafe { runs_avx512::<UNIFORM, R>(args) },
+            Self::Avx512 => unsafe {
+                match batch_choice::avx512_run_width() {
+                    RunWidth::Eight => runs_avx512_eight::<UNIFORM, R>(args),
+                    RunWidth::Four => runs_avx2::<UNIFORM, R>(args),
+                }
+            },
             #[cfg(not(target_arch = "x86_64"))]
             _ => scatter_runs::<UNIFORM, R, GROUP>(args, group_by_lane),
         }
@@ -203,14 +226,14 @@ fn scatter_avx512<const UNIFORM: bool, R: RestLookup>(layout: BatchLayout, args:
 /// The run loop compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn runs_avx2<const UNIFORM: bool, R: RestLookup>(args: RunArgs<R>) {
+pub(crate) fn runs_avx2<const UNIFORM: bool, R: RestLookup>(args: RunArgs<R>) {
     scatter_runs::<UNIFORM, R, GROUP>(args, |g| run_avx2::group_avx2(g));
 }
 
 /// The run loop compiled for AVX-512, eight springs per group.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx2")]
-fn runs_avx512<const UNIFORM: bool, R: RestLookup>(args: RunArgs<R>) {
+pub(crate) fn runs_avx512_eight<const UNIFORM: bool, R: RestLookup>(args: RunArgs<R>) {
     scatter_runs::<UNIFORM, R, { run_avx512::WIDE }>(args, |g| run_avx512::group_avx512(g));
 }
 
@@ -341,7 +364,9 @@ pub(crate) mod tests {
         let params: Vec<[f64; 2]> = vec![[100.0, 0.25], [200.0, 0.5], [300.0, 0.0]];
         let param: Vec<u32> = (0..ends.len() as u32).map(|k| k % 3).collect();
         let forces = |kernel: Kernel, layout: BatchLayout| {
-            let mut f = vec![Vec3::zeros(); x.len()];
+            let mut f = vec![0.0; 3 * x.len()];
+            let (fx, fyz) = f.split_at_mut(x.len());
+            let (fy, fz) = fyz.split_at_mut(x.len());
             kernel.scatter_with::<false, _>(
                 layout,
                 ScatterArgs {
@@ -350,14 +375,12 @@ pub(crate) mod tests {
                     param: &param,
                     params: &params,
                     lo: 0,
-                    force: &mut f,
+                    force: [fx, fy, fz],
                     x: &x,
                     v: &v,
                 },
             );
-            f.iter()
-                .flat_map(|f| f.iter().map(|c| c.to_bits()))
-                .collect::<Vec<u64>>()
+            f.iter().map(|c| c.to_bits()).collect::<Vec<u64>>()
         };
         let portable = forces(Kernel::Portable, BatchLayout::Component);
         assert!(portable.iter().any(|&b| b != 0), "the springs pull");
@@ -370,7 +393,7 @@ pub(crate) mod tests {
     /// neighbour within distance 2 along each axis and the face and body diagonals, as a
     /// cloth (`a = 1`) or a jelly cube has, with `extra` springs between random particles
     /// and, unless `uniform`, stiffness and damping by kind.
-    fn lattice(
+    pub(crate) fn lattice(
         [a, b, c]: [usize; 3],
         extra: usize,
         uniform: bool,

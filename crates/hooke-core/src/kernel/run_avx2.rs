@@ -1,7 +1,8 @@
-//! The group step of the run loop in AVX2 registers: four springs per instruction, their
-//! ends' coordinates transposed between the particles' layout and the components' by
-//! shuffles. Every lane does [`crate::spring::spring_formula`]'s operations in its order
-//! (no fused multiply-adds), so the bits are the portable kernel's, as a test checks.
+//! The group step of the run loop in AVX2 registers: four springs per instruction, the
+//! upper ends' coordinates transposed from the particles' layout to the components' by
+//! shuffles (the window they add into is by component already). Every lane does
+//! [`crate::spring::spring_formula`]'s operations in its order (no fused multiply-adds),
+//! so the bits are the portable kernel's, as a test checks.
 
 #![cfg(target_arch = "x86_64")]
 
@@ -42,21 +43,6 @@ fn transpose_in(p: &[f64; 3 * GROUP]) -> [__m256d; 3] {
     ]
 }
 
-/// The inverse of [`transpose_in`].
-#[target_feature(enable = "avx2")]
-#[inline]
-fn transpose_out([x, y, z]: [__m256d; 3]) -> [f64; 3 * GROUP] {
-    let xy02 = _mm256_shuffle_pd::<0b0000>(x, y); // x0 y0 x2 y2
-    let zx13 = _mm256_shuffle_pd::<0b1010>(z, x); // z0 x1 z2 x3
-    let yz13 = _mm256_shuffle_pd::<0b1111>(y, z); // y1 z1 y3 z3
-    let quarters = [
-        store(_mm256_permute2f128_pd::<0x20>(xy02, zx13)),
-        store(_mm256_blend_pd::<0b1100>(yz13, xy02)),
-        store(_mm256_permute2f128_pd::<0x31>(zx13, yz13)),
-    ];
-    bytemuck::cast(quarters)
-}
-
 /// [`super::run_loop::group_by_lane`] in AVX2 registers.
 #[target_feature(enable = "avx2")]
 #[inline]
@@ -86,7 +72,7 @@ pub(crate) fn group_avx2(g: Group<GROUP>) {
     for (c, keep) in g.keep.into_iter().enumerate() {
         *keep = store(f[c]);
     }
-    let out = transpose_in(&flat(g.out));
-    let out: [__m256d; 3] = std::array::from_fn(|c| _mm256_sub_pd(out[c], f[c]));
-    *g.out = bytemuck::cast(transpose_out(out));
+    for (c, out) in g.out.into_iter().enumerate() {
+        *out = store(_mm256_sub_pd(load(out), f[c]));
+    }
 }

@@ -1,8 +1,8 @@
 //! The group step of the run loop in AVX-512 registers: eight springs per instruction,
-//! their ends' coordinates transposed between the particles' layout and the components'
-//! by two-source permutes. Every lane does [`crate::spring::spring_formula`]'s operations
-//! in its order (no fused multiply-adds), so the bits are the portable kernel's, as a test
-//! checks.
+//! the upper ends' coordinates transposed from the particles' layout to the components'
+//! by two-source permutes (the window they add into is by component already). Every lane
+//! does [`crate::spring::spring_formula`]'s operations in its order (no fused
+//! multiply-adds), so the bits are the portable kernel's, as a test checks.
 
 #![cfg(target_arch = "x86_64")]
 
@@ -34,13 +34,6 @@ const GATHER: [[[i64; WIDE]; 2]; 3] = [
     [[2, 5, 8, 11, 14, 0, 0, 0], [0, 1, 2, 3, 4, 9, 12, 15]],
 ];
 
-/// For third `t` of the flat coordinates: picks from the x and y vectors, then adds z.
-const SCATTER: [[[i64; WIDE]; 2]; 3] = [
-    [[0, 8, 0, 1, 9, 0, 2, 10], [0, 1, 8, 3, 4, 9, 6, 7]],
-    [[0, 3, 11, 0, 4, 12, 0, 5], [10, 1, 2, 11, 4, 5, 12, 7]],
-    [[13, 0, 6, 14, 0, 7, 15, 0], [0, 13, 2, 3, 14, 5, 6, 15]],
-];
-
 #[inline(always)]
 fn load(v: &[f64; WIDE]) -> __m512d {
     bytemuck::cast(*v)
@@ -62,18 +55,6 @@ fn transpose_in(p: &Flat) -> [__m512d; 3] {
         let ab = _mm512_permutex2var_pd(a, index(first), b);
         _mm512_permutex2var_pd(ab, index(then), c)
     })
-}
-
-/// The inverse of [`transpose_in`].
-#[target_feature(enable = "avx512f")]
-#[inline]
-fn transpose_out([x, y, z]: [__m512d; 3]) -> Flat {
-    let thirds: [[f64; WIDE]; 3] = std::array::from_fn(|t| {
-        let [first, then] = SCATTER[t];
-        let xy = _mm512_permutex2var_pd(x, index(first), y);
-        store(_mm512_permutex2var_pd(xy, index(then), z))
-    });
-    bytemuck::cast(thirds)
 }
 
 /// [`super::run_loop::group_by_lane`] in AVX-512 registers.
@@ -105,7 +86,7 @@ pub(crate) fn group_avx512(g: Group<WIDE>) {
     for (c, keep) in g.keep.into_iter().enumerate() {
         *keep = store(f[c]);
     }
-    let out = transpose_in(&flat(g.out));
-    let out: [__m512d; 3] = std::array::from_fn(|c| _mm512_sub_pd(out[c], f[c]));
-    *g.out = bytemuck::cast(transpose_out(out));
+    for (c, out) in g.out.into_iter().enumerate() {
+        *out = store(_mm512_sub_pd(load(out), f[c]));
+    }
 }

@@ -9,9 +9,10 @@
 //!
 //! Springs go in groups of four (eight with AVX-512): the vector kernels load the upper
 //! ends' coordinates as consecutive values, transpose them in registers, compute the
-//! group's forces in one instruction per operation and transpose them back (`run_avx2.rs`,
-//! `run_avx512.rs`); the portable kernel does the same lane by lane. The lower ends of a
-//! chunk of runs sit in component layout throughout. The group's width is the vector's:
+//! group's forces in one instruction per operation and subtract them from the window,
+//! which holds forces by component (`run_avx2.rs`, `run_avx512.rs`); the portable kernel
+//! does the same lane by lane. The lower ends of a chunk of runs sit in component layout
+//! throughout, and so do their forces until they are added to the window. The group's width is the vector's:
 //! on a core that issues a 512-bit operation at half the rate of a 256-bit one, eight
 //! springs per instruction still halve the instructions waiting on each square root and
 //! division, which is what bounds a group's overlap with the next.
@@ -46,6 +47,9 @@ pub(crate) struct Run {
     pub len: u32,
     /// The assembly index of the run's first spring (its rest length and parameters).
     pub first: u32,
+    /// Whether every spring of the run has the first one's rest length (as on a grid), so
+    /// that the loop reads it once instead of once per spring.
+    pub same_rest: bool,
 }
 
 /// The arguments of [`scatter_runs`] for one partition.
@@ -71,8 +75,8 @@ pub(crate) struct Group<'a, const W: usize> {
     /// The upper ends' positions and velocities.
     pub xb: &'a [[f64; 3]; W],
     pub vb: &'a [[f64; 3]; W],
-    /// The upper ends' forces: the step subtracts each spring's force.
-    pub out: &'a mut [[f64; 3]; W],
+    /// The upper ends' forces, by component: the step subtracts each spring's force.
+    pub out: [&'a mut [f64; W]; 3],
     /// Rest lengths, stiffnesses and dampings.
     pub rest: [f64; W],
     pub ks: [f64; W],
@@ -101,7 +105,7 @@ pub(crate) fn group_by_lane<const W: usize>(g: Group<W>) {
         let f = spring_formula(d, dv, g.rest[l], g.ks[l], g.kd[l]);
         for (c, f) in f.into_iter().enumerate() {
             g.keep[c][l] = f;
-            g.out[l][c] -= f;
+            g.out[c][l] -= f;
         }
     }
 }
@@ -127,14 +131,13 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup, const W: usize>(
         param,
         params,
         lo,
-        force,
+        mut force,
         x,
         v,
     }: RunArgs<R>,
     mut group: impl FnMut(Group<W>),
 ) {
     let (x, v): (&[[f64; 3]], &[[f64; 3]]) = (bytemuck::cast_slice(x), bytemuck::cast_slice(v));
-    let force: &mut [[f64; 3]] = bytemuck::cast_slice_mut(force);
     // On the stack (15 KiB): stepping allocates nothing.
     let mut chunk = Chunk {
         x: [[0.0; RUN_CHUNK]; 3],
@@ -161,7 +164,10 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup, const W: usize>(
         let last = pieces.iter().map(|r| r.lo + r.len).max().unwrap_or(0) as usize;
         let span = (last - first).min(RUN_CHUNK);
         let chunk = &mut chunk;
-        let (xs, vs) = (&x[first..first + span], &v[first..first + span]);
+        let (xs, vs) = (
+            &x[first - lo..first - lo + span],
+            &v[first - lo..first - lo + span],
+        );
         for c in 0..3 {
             for l in 0..span {
                 chunk.x[c][l] = xs[l][c];
@@ -197,9 +203,11 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup, const W: usize>(
             let n = (piece.len as usize).min(span - i);
             let j = piece.lo as usize + piece.offset as usize;
             let k = piece.first as usize;
-            let (xb, vb) = (&x[j..j + n], &v[j..j + n]);
-            let out = &mut force[j - lo..j - lo + n];
+            let (xb, vb) = (&x[j - lo..j - lo + n], &v[j - lo..j - lo + n]);
+            let [o0, o1, o2] = &mut force;
+            let mut out = [o0, o1, o2].map(|o| &mut o[j - lo..j - lo + n]);
             let rest = rest.slice(k..k + n);
+            let same_rest = piece.same_rest.then(|| rest.rest(0));
             let param = if UNIFORM { &[][..] } else { &param[k..k + n] };
             let ks_kd = |l: usize| {
                 if UNIFORM {
@@ -220,8 +228,13 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup, const W: usize>(
                     keep: [lanes_mut(f0, a), lanes_mut(f1, a), lanes_mut(f2, a)],
                     xb: xb[g..g + W].try_into().expect("a group's ends"),
                     vb: vb[g..g + W].try_into().expect("a group's ends"),
-                    out: (&mut out[g..g + W]).try_into().expect("a group's ends"),
-                    rest: std::array::from_fn(|l| rest.rest(g + l)),
+                    out: out
+                        .each_mut()
+                        .map(|o| (&mut o[g..g + W]).try_into().expect("a group's ends")),
+                    rest: match same_rest {
+                        Some(r) => [r; W],
+                        None => std::array::from_fn(|l| rest.rest(g + l)),
+                    },
                     ks: pairs.map(|p| p[0]),
                     kd: pairs.map(|p| p[1]),
                 });
@@ -235,7 +248,7 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup, const W: usize>(
                 let f = spring_formula(dx, dv, rest.rest(l), ks, kd);
                 for c in 0..3 {
                     kept[c][a] = f[c];
-                    out[l][c] -= f[c];
+                    out[c][l] -= f[c];
                 }
             }
         }
@@ -248,9 +261,9 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup, const W: usize>(
         // Each lower end's pull: its pieces' forces by ascending offset, from zero, added to
         // the window. Eight lanes at a time the sum stays in one register across the rows.
         let rows = &chunk.forces[..rows];
-        let out = &mut force[first - lo..first - lo + span];
         let whole = span / PULL_LANES * PULL_LANES;
-        for c in 0..3 {
+        for (c, out) in force.iter_mut().enumerate() {
+            let out = &mut out[first - lo..first - lo + span];
             for a in (0..whole).step_by(PULL_LANES) {
                 let mut pull = [0.0; PULL_LANES];
                 for row in rows.iter().rev() {
@@ -258,10 +271,9 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup, const W: usize>(
                         *p += f;
                     }
                 }
-                for (k, p) in pull.into_iter().enumerate() {
-                    if chunk.lower[a + k] {
-                        out[a + k][c] += p;
-                    }
+                let (out, lower) = (&mut out[a..a + PULL_LANES], &chunk.lower[a..a + PULL_LANES]);
+                for ((o, p), &lower) in out.iter_mut().zip(pull).zip(lower) {
+                    *o = if lower { *o + p } else { *o };
                 }
             }
             for l in whole..span {
@@ -270,7 +282,7 @@ pub(crate) fn scatter_runs<const UNIFORM: bool, R: RestLookup, const W: usize>(
                     for row in rows.iter().rev() {
                         pull += row[c][l];
                     }
-                    out[l][c] += pull;
+                    out[l] += pull;
                 }
             }
         }
