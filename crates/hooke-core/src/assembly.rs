@@ -153,11 +153,14 @@ struct Partition {
     lo: usize,
     /// The window's length: it covers particles `lo..lo + len`.
     len: usize,
-    /// The window's buffer: the forces by component, each component's in one of three
-    /// equal thirds (its first `len` entries), so that the run loop adds a group of
-    /// springs' forces with whole vectors and no transposition. Its thirds are as long as
-    /// the longest window where windows are of about one length, so that the one-pass step
-    /// can hand a buffer still in cache from one partition to another (see `fused.rs`).
+    /// The window's buffer, room for three values per particle. A partition laid out as
+    /// runs keeps its forces by component, each component's in one of three equal thirds
+    /// (its first `len` entries), so that the run loop adds a group of springs' forces with
+    /// whole vectors and no transposition; one for the per-spring loop keeps each force
+    /// whole in its first `3 len` values, as that loop updates one particle at a time. The
+    /// buffer has room for the longest window where windows are of about one length, so
+    /// that the one-pass step can hand a buffer still in cache from one partition to
+    /// another (see `fused.rs`).
     force: Vec<f64>,
 }
 
@@ -167,13 +170,40 @@ impl Partition {
         self.force.len() / 3
     }
 
-    /// The window by component: the forces on particles `lo..lo + len`.
+    /// Whether the window holds forces by component (the partition is laid out as runs).
+    fn by_component(&self) -> bool {
+        !self.runs.is_empty()
+    }
+
+    /// The window by component, of a partition laid out as runs: the forces on particles
+    /// `lo..lo + len`.
     fn window(&self) -> [&[f64]; 3] {
         let third = self.capacity();
         [0, 1, 2].map(|c| &self.force[c * third..c * third + self.len])
     }
 
-    /// The window, to write.
+    /// The window with each force whole, of a partition for the per-spring loop.
+    fn whole(&self) -> &[Vec3] {
+        bytemuck::cast_slice(&self.force[..3 * self.len])
+    }
+
+    /// [`Partition::whole`], to write.
+    fn whole_mut(&mut self) -> &mut [Vec3] {
+        bytemuck::cast_slice_mut(&mut self.force[..3 * self.len])
+    }
+
+    /// Zeroes the window.
+    fn clear(&mut self) {
+        if self.by_component() {
+            for c in self.window_mut() {
+                c.fill(0.0);
+            }
+        } else {
+            self.whole_mut().fill(Vec3::zeros());
+        }
+    }
+
+    /// [`Partition::window`], to write.
     fn window_mut(&mut self) -> Window<'_> {
         let (third, len) = (self.capacity(), self.len);
         let (x, rest) = self.force.split_at_mut(third);
@@ -186,9 +216,19 @@ impl Partition {
     fn add_to(&self, start: usize, out: &mut [Vec3]) {
         let (lo, hi) = (self.lo.max(start), self.hi().min(start + out.len()));
         if lo < hi {
-            let [x, y, z] = self.window().map(|c| &c[lo - self.lo..hi - self.lo]);
-            for (k, o) in out[lo - start..hi - start].iter_mut().enumerate() {
-                *o += Vec3::new(x[k], y[k], z[k]);
+            let out = &mut out[lo - start..hi - start];
+            if self.by_component() {
+                let [x, y, z] = self.window().map(|c| &c[lo - self.lo..hi - self.lo]);
+                for (k, o) in out.iter_mut().enumerate() {
+                    *o += Vec3::new(x[k], y[k], z[k]);
+                }
+            } else {
+                for (o, f) in out
+                    .iter_mut()
+                    .zip(&self.whole()[lo - self.lo..hi - self.lo])
+                {
+                    *o += f;
+                }
             }
         }
     }
@@ -325,10 +365,7 @@ fn scatter_partition(
     v: &[Vec3],
 ) {
     let (lo, springs, pieces) = (part.lo, part.springs.clone(), part.runs.clone());
-    let mut force = part.window_mut();
-    for c in &mut force {
-        c.fill(0.0);
-    }
+    part.clear();
     let uniform = table.param.is_empty();
     let params = &table.params[..];
     let runs = &runs[pieces];
@@ -341,7 +378,7 @@ fn scatter_partition(
                     param: &table.param,
                     params,
                     lo,
-                    force: force.each_mut().map(|c| &mut **c),
+                    force: part.window_mut(),
                     x,
                     v,
                 }
@@ -360,6 +397,7 @@ fn scatter_partition(
         return;
     }
     let r = springs;
+    let force = part.whole_mut();
     let ends = &table.ends[r.clone()];
     let param = if uniform {
         &[][..]
@@ -561,17 +599,25 @@ impl Assembly {
         let table = &self.table;
         let scatter = |part: &mut Partition| {
             let (lo, springs) = (part.lo, part.springs.clone());
-            let mut window = part.window_mut();
-            for c in &mut window {
-                c.fill(0.0);
-            }
+            part.clear();
+            let by_component = part.by_component();
+            let add = |window: &mut Window, k: usize, f: Vec3| {
+                for (c, w) in window.iter_mut().enumerate() {
+                    w[k] += f[c];
+                }
+            };
             for k in springs {
                 let [i, j] = table.ends[k];
-                let (i, j) = (i as usize, j as usize);
-                let f = g(k, i, j);
-                for (c, w) in window.iter_mut().enumerate() {
-                    w[i - lo] += f[c];
-                    w[j - lo] -= f[c];
+                let (i, j) = (i as usize - lo, j as usize - lo);
+                let f = g(k, i + lo, j + lo);
+                if by_component {
+                    let mut window = part.window_mut();
+                    add(&mut window, i, f);
+                    add(&mut window, j, -f);
+                } else {
+                    let window = part.whole_mut();
+                    window[i] += f;
+                    window[j] -= f;
                 }
             }
         };

@@ -55,6 +55,7 @@ fn update<const GRAVITY_ONLY: bool>(
             if inv_mass[k] == 0.0 {
                 continue;
             }
+            let (xk, vk) = (x[k], v[k]);
             let f = if GRAVITY_ONLY {
                 model.gravity * mass[k] + springs[k]
             } else {
@@ -64,10 +65,10 @@ fn update<const GRAVITY_ONLY: bool>(
                 } else {
                     springs[k] + air[start + k]
                 };
-                model.total_force(start + k, mass[k], &x[k], &v[k], pairwise)
+                model.total_force(start + k, mass[k], &xk, &vk, pairwise)
             };
-            v[k] += f * inv_mass[k] * dt;
-            x[k] += v[k] * dt;
+            v[k] = vk + f * inv_mass[k] * dt;
+            x[k] = xk + v[k] * dt;
         }
         parallel::sane(&x[..n], &v[..n], SANE_BOUND)
     };

@@ -66,7 +66,7 @@ unsafe fn faster_layout() -> BatchLayout {
         .filter(|&[_, j]| (j as usize) < PARTICLES)
         .collect();
     let rest = vec![0.1; ends.len()];
-    let mut force = vec![0.0; 3 * PARTICLES];
+    let mut force = vec![Vec3::zeros(); PARTICLES];
     let mut pass = |layout: BatchLayout| {
         let args = ScatterArgs {
             springs: &ends[..],
@@ -74,11 +74,7 @@ unsafe fn faster_layout() -> BatchLayout {
             param: &[],
             params: &[[1000.0, 0.01]],
             lo: 0,
-            force: {
-                let (x, rest) = force.split_at_mut(PARTICLES);
-                let (y, z) = rest.split_at_mut(PARTICLES);
-                [x, y, z]
-            },
+            force: &mut force[..],
             x: &x,
             v: &v,
         };

@@ -38,10 +38,6 @@ impl RestLookup for (&[u16], &[f64]) {
     }
 }
 
-/// A partition's window of forces by component: `force[c][k]` is component `c` of the
-/// force on particle `lo + k`.
-pub(crate) type Window<'a> = [&'a mut [f64]; 3];
-
 /// Springs per batch of the force loop.
 pub(crate) const LANES: usize = 64;
 
@@ -101,26 +97,26 @@ pub(crate) fn scatter_springs<const UNIFORM: bool, R: RestLookup, B: SpringBatch
             let (i, j) = (i as usize, j as usize);
             let f = batch.force(l);
             if i != current {
-                for c in 0..3 {
-                    force[c][current - lo] += pull[c];
-                }
+                force[current - lo] += pull;
                 pull = Vec3::zeros();
                 current = i;
             }
             pull += f;
-            for c in 0..3 {
-                force[c][j - lo] -= f[c];
-            }
+            force[j - lo] -= f;
         }
     }
-    for c in 0..3 {
-        force[c][current - lo] += pull[c];
-    }
+    force[current - lo] += pull;
 }
 
+/// A partition's window of forces by component: `force[c][k]` is component `c` of the
+/// force on particle `lo + k`.
+pub(crate) type Window<'a> = [&'a mut [f64]; 3];
+
 /// The arguments of a force loop for one partition: [`scatter_springs`]'s, whose springs
-/// are end pairs, or `super::run_loop::scatter_runs`'s, whose springs come in runs.
-pub(crate) struct ScatterArgs<'a, R, S = &'a [[u32; 2]]> {
+/// are end pairs and whose window holds each force whole, or
+/// `super::run_loop::scatter_runs`'s, whose springs come in runs and whose window holds
+/// forces by component ([`Window`]).
+pub(crate) struct ScatterArgs<'a, R, S = &'a [[u32; 2]], F = &'a mut [Vec3]> {
     /// The springs: their ends, lower end first, or runs of them.
     pub springs: S,
     /// Their rest lengths: from the first of `springs` for end pairs, by assembly index
@@ -134,7 +130,7 @@ pub(crate) struct ScatterArgs<'a, R, S = &'a [[u32; 2]]> {
     /// The window's first particle.
     pub lo: usize,
     /// The window's forces, particle `lo + k` at `k`.
-    pub force: Window<'a>,
+    pub force: F,
     /// The window's positions, particle `lo + k` at `k`.
     pub x: &'a [Vec3],
     /// The window's velocities, as `x`.

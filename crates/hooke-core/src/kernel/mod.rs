@@ -364,9 +364,7 @@ pub(crate) mod tests {
         let params: Vec<[f64; 2]> = vec![[100.0, 0.25], [200.0, 0.5], [300.0, 0.0]];
         let param: Vec<u32> = (0..ends.len() as u32).map(|k| k % 3).collect();
         let forces = |kernel: Kernel, layout: BatchLayout| {
-            let mut f = vec![0.0; 3 * x.len()];
-            let (fx, fyz) = f.split_at_mut(x.len());
-            let (fy, fz) = fyz.split_at_mut(x.len());
+            let mut f = vec![Vec3::zeros(); x.len()];
             kernel.scatter_with::<false, _>(
                 layout,
                 ScatterArgs {
@@ -375,12 +373,14 @@ pub(crate) mod tests {
                     param: &param,
                     params: &params,
                     lo: 0,
-                    force: [fx, fy, fz],
+                    force: &mut f,
                     x: &x,
                     v: &v,
                 },
             );
-            f.iter().map(|c| c.to_bits()).collect::<Vec<u64>>()
+            f.iter()
+                .flat_map(|f| f.iter().map(|c| c.to_bits()))
+                .collect::<Vec<u64>>()
         };
         let portable = forces(Kernel::Portable, BatchLayout::Component);
         assert!(portable.iter().any(|&b| b != 0), "the springs pull");

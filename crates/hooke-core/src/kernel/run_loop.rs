@@ -53,7 +53,7 @@ pub(crate) struct Run {
 }
 
 /// The arguments of [`scatter_runs`] for one partition.
-pub(crate) type RunArgs<'a, R> = super::ScatterArgs<'a, R, &'a [Run]>;
+pub(crate) type RunArgs<'a, R> = super::ScatterArgs<'a, R, &'a [Run], super::Window<'a>>;
 
 /// A chunk's lower ends in component layout, read once per chunk, and the forces of its
 /// pieces, one row per offset (pieces of one offset cover distinct lower ends), kept until
