@@ -211,6 +211,16 @@ impl Partition {
         [&mut x[..len], &mut y[..len], &mut z[..len]]
     }
 
+    /// Where in the buffer component `c` of the force on particle `lo + k` is: in its
+    /// third, or in the particle's triple.
+    fn at(&self, k: usize, c: usize) -> usize {
+        if self.by_component() {
+            c * self.capacity() + k
+        } else {
+            3 * k + c
+        }
+    }
+
     /// Adds the window's forces on particles `start..start + out.len()` (where they meet it)
     /// to `out`.
     fn add_to(&self, start: usize, out: &mut [Vec3]) {
@@ -598,26 +608,15 @@ impl Assembly {
     pub fn scatter_pairs(&mut self, g: impl Fn(usize, usize, usize) -> Vec3 + Sync) {
         let table = &self.table;
         let scatter = |part: &mut Partition| {
-            let (lo, springs) = (part.lo, part.springs.clone());
             part.clear();
-            let by_component = part.by_component();
-            let add = |window: &mut Window, k: usize, f: Vec3| {
-                for (c, w) in window.iter_mut().enumerate() {
-                    w[k] += f[c];
-                }
-            };
-            for k in springs {
+            for k in part.springs.clone() {
                 let [i, j] = table.ends[k];
-                let (i, j) = (i as usize - lo, j as usize - lo);
-                let f = g(k, i + lo, j + lo);
-                if by_component {
-                    let mut window = part.window_mut();
-                    add(&mut window, i, f);
-                    add(&mut window, j, -f);
-                } else {
-                    let window = part.whole_mut();
-                    window[i] += f;
-                    window[j] -= f;
+                let (i, j) = (i as usize, j as usize);
+                let f = g(k, i, j);
+                for (c, f) in f.iter().enumerate() {
+                    let (a, b) = (part.at(i - part.lo, c), part.at(j - part.lo, c));
+                    part.force[a] += f;
+                    part.force[b] -= f;
                 }
             }
         };

@@ -301,13 +301,8 @@ mod tests {
     fn both_batch_layouts_give_the_formula_s_bits() {
         // Only the AVX-512 kernel uses whole vectors, and not every CPU runs it: this checks
         // both layouts on any machine, against the one formula.
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut unit = crate::kernel::unit_numbers(0x9e37_79b9_7f4a_7c15);
+        let mut next = move || unit() - 0.5;
         let mut springs: Vec<_> = (0..999)
             .map(|k| {
                 let d = Vec3::new(next(), next(), next()) * 10f64.powi(k % 7 - 3);

@@ -313,7 +313,7 @@ impl Assembly {
 mod tests {
     use crate::assembly::Assembly;
     use crate::collider::{Collider, Contact};
-    use crate::kernel::tests::jumble;
+    use crate::kernel::tests::{bits, jumble, pool};
     use crate::model::{ColliderSlot, Model};
     use crate::particles::Vec3;
     use crate::response::Response;
@@ -342,10 +342,6 @@ mod tests {
             let clear = lo.y - self.0 >= margin;
             !clear
         }
-    }
-
-    fn bits(a: &[Vec3]) -> Vec<[u64; 3]> {
-        a.iter().map(|f| f.map(f64::to_bits).into()).collect()
     }
 
     /// The one-call pass (up to [`super::MAX_PARTS`] partitions, here 1, 2 and 5) gives the
@@ -382,10 +378,7 @@ mod tests {
             let mut expected = vec![Vec3::zeros(); n];
             Assembly::new(n, &springs).accelerations(&model, masses, (&x, &v), &[], &mut expected);
             for threads in 1..=4 {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()
-                    .unwrap();
+                let pool = pool(threads);
                 let mut asm = Assembly::new(n, &springs);
                 assert_eq!(asm.is_small(), count < 40_000, "{count} springs");
                 for round in 0..3 {
@@ -449,10 +442,7 @@ mod tests {
         };
         let (x, mass) = (vec![Vec3::zeros(); n], vec![1.0; n]);
         for threads in 1..=3 {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
+            let pool = pool(threads);
             let mut asm = Assembly::new(n, &springs);
             let (mut a, mut o1, mut o2) = (x.clone(), x.clone(), x.clone());
             let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {

@@ -45,16 +45,33 @@ pub(crate) unsafe fn avx512_layout() -> BatchLayout {
 const PARTICLES: usize = 512;
 const OFFSETS: [u32; 8] = [1, 2, 7, 8, 9, 16, 63, 64];
 
-/// Times both layouts, interleaved, and returns the one with the faster best pass.
-#[allow(unsafe_code)]
-unsafe fn faster_layout() -> BatchLayout {
-    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-    let mut next = move || {
+/// A deterministic stream of numbers in `[0, 1)` (xorshift64 from `seed`, which must not
+/// be zero): the timed systems' jitter, and the test systems'.
+pub(crate) fn unit_numbers(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
         seed ^= seed << 13;
         seed ^= seed >> 7;
         seed ^= seed << 17;
         (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    }
+}
+
+/// Whether `second` is the faster of two ways of doing one job, `pass(false)` timing the
+/// first and `pass(true)` the second: nine interleaved rounds and the best of each, as a
+/// neighbour's burst slows some passes of both, not all of one.
+fn second_is_faster(mut pass: impl FnMut(bool) -> Duration) -> bool {
+    let mut best = [Duration::MAX; 2];
+    for _ in 0..9 {
+        best[0] = best[0].min(pass(false));
+        best[1] = best[1].min(pass(true));
+    }
+    best[1] < best[0]
+}
+
+/// Times both layouts and returns the one with the faster best pass.
+#[allow(unsafe_code)]
+unsafe fn faster_layout() -> BatchLayout {
+    let mut next = unit_numbers(0x2545_f491_4f6c_dd1d);
     let x: Vec<Vec3> = (0..PARTICLES)
         .map(|p| Vec3::new(p as f64 * 0.1 + next(), next(), next()))
         .collect();
@@ -67,7 +84,7 @@ unsafe fn faster_layout() -> BatchLayout {
         .collect();
     let rest = vec![0.1; ends.len()];
     let mut force = vec![Vec3::zeros(); PARTICLES];
-    let mut pass = |layout: BatchLayout| {
+    let pass = |vector: bool| {
         let args = ScatterArgs {
             springs: &ends[..],
             rest: &rest[..],
@@ -81,21 +98,15 @@ unsafe fn faster_layout() -> BatchLayout {
         let start = Instant::now();
         // SAFETY: passed on from the caller.
         unsafe {
-            match layout {
-                BatchLayout::Component => timed::<ComponentBatch<LANES>>(args),
-                BatchLayout::Vector => timed::<VectorBatch<LANES>>(args),
+            if vector {
+                timed::<VectorBatch<LANES>>(args)
+            } else {
+                timed::<ComponentBatch<LANES>>(args)
             }
         }
         start.elapsed()
     };
-    let mut best = [Duration::MAX; 2];
-    // Interleaved rounds and the best of each: a neighbour's burst slows some passes of
-    // both, not all of one.
-    for _ in 0..9 {
-        best[0] = best[0].min(pass(BatchLayout::Component));
-        best[1] = best[1].min(pass(BatchLayout::Vector));
-    }
-    if best[1] < best[0] {
+    if second_is_faster(pass) {
         BatchLayout::Vector
     } else {
         BatchLayout::Component
@@ -133,17 +144,12 @@ const SIDE: usize = 64;
 
 /// A `SIDE × SIDE` cloth's structural, shear and bend springs as the layout hands them to
 /// the run loop (24k springs, all in L2): cut at chunks of lower ends, by chunk and then by
-/// offset from the largest; and its particles' positions and velocities, jittered by `seed`.
-fn run_grid(seed: u64) -> (Vec<Run>, Vec<Vec3>, Vec<Vec3>) {
+/// offset from the largest, with their rest lengths; and its particles' positions and
+/// velocities, jittered by `seed`.
+fn run_grid(seed: u64) -> RunGrid {
     use super::run_loop::RUN_CHUNK;
     let n = SIDE * SIDE;
-    let mut seed = seed | 1;
-    let mut next = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = unit_numbers(seed | 1);
     let x: Vec<Vec3> = (0..n)
         .map(|p| Vec3::new((p % SIDE) as f64 + next(), (p / SIDE) as f64, next()) * 0.1)
         .collect();
@@ -161,29 +167,37 @@ fn run_grid(seed: u64) -> (Vec<Run>, Vec<Vec3>, Vec<Vec3>) {
             });
         }
     }
-    (runs, x, v)
+    let rest = vec![0.1; runs.len() * RUN_CHUNK];
+    RunGrid { runs, rest, x, v }
 }
 
-/// The run loop over `runs` at `(x, v)` with groups of `width`, into `force` (by
-/// component, thirds of equal length).
+/// [`run_grid`]'s system.
+struct RunGrid {
+    runs: Vec<Run>,
+    rest: Vec<f64>,
+    x: Vec<Vec3>,
+    v: Vec<Vec3>,
+}
+
+/// The run loop over `grid` with groups of `width`, into `force` (by component, thirds of
+/// equal length).
 ///
 /// # Safety
 /// The CPU must support AVX-512F, AVX-512VL and AVX2.
 #[allow(unsafe_code)]
-unsafe fn run_pass(width: RunWidth, runs: &[Run], (x, v): (&[Vec3], &[Vec3]), force: &mut [f64]) {
-    let n = x.len();
+unsafe fn run_pass(width: RunWidth, grid: &RunGrid, force: &mut [f64]) {
+    let n = grid.x.len();
     let (fx, fyz) = force.split_at_mut(n);
     let (fy, fz) = fyz.split_at_mut(n);
-    let rest = vec![0.1; runs.iter().map(|r| r.len as usize).sum()];
     let args = RunArgs {
-        springs: runs,
-        rest: &rest[..],
+        springs: &grid.runs,
+        rest: &grid.rest[..],
         param: &[],
         params: &[[1000.0, 0.01]],
         lo: 0,
         force: [fx, fy, fz],
-        x,
-        v,
+        x: &grid.x,
+        v: &grid.v,
     };
     // SAFETY: passed on from the caller.
     unsafe {
@@ -194,24 +208,23 @@ unsafe fn run_pass(width: RunWidth, runs: &[Run], (x, v): (&[Vec3], &[Vec3]), fo
     }
 }
 
-/// Times both group widths on [`run_grid`], interleaved, and returns the one with the
-/// faster best pass.
+/// Times both group widths on [`run_grid`] and returns the one with the faster best pass.
 #[allow(unsafe_code)]
 unsafe fn faster_run_width() -> RunWidth {
-    let (runs, x, v) = run_grid(1);
-    let mut force = vec![0.0; 3 * x.len()];
-    let mut pass = |width: RunWidth| {
+    let grid = run_grid(1);
+    let mut force = vec![0.0; 3 * grid.x.len()];
+    let pass = |four: bool| {
+        let width = if four {
+            RunWidth::Four
+        } else {
+            RunWidth::Eight
+        };
         let start = Instant::now();
         // SAFETY: passed on from the caller.
-        unsafe { run_pass(width, &runs, (&x, &v), &mut force) };
+        unsafe { run_pass(width, &grid, &mut force) };
         start.elapsed()
     };
-    let mut best = [Duration::MAX; 2];
-    for _ in 0..9 {
-        best[0] = best[0].min(pass(RunWidth::Eight));
-        best[1] = best[1].min(pass(RunWidth::Four));
-    }
-    if best[1] < best[0] {
+    if second_is_faster(pass) {
         RunWidth::Four
     } else {
         RunWidth::Eight
@@ -231,11 +244,11 @@ mod tests {
             return;
         }
         for seed in [3, 17] {
-            let (runs, x, v) = run_grid(seed);
+            let grid = run_grid(seed);
             let forces = |width| {
-                let mut force = vec![0.0; 3 * x.len()];
+                let mut force = vec![0.0; 3 * grid.x.len()];
                 // SAFETY: the CPU has AVX-512 (checked above).
-                unsafe { run_pass(width, &runs, (&x, &v), &mut force) };
+                unsafe { run_pass(width, &grid, &mut force) };
                 force.iter().map(|f| f.to_bits()).collect::<Vec<u64>>()
             };
             let eight = forces(RunWidth::Eight);

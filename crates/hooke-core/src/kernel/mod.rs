@@ -19,6 +19,8 @@ mod run_loop;
 pub(crate) use batch_choice::BatchLayout;
 #[cfg(target_arch = "x86_64")]
 use batch_choice::RunWidth;
+#[cfg(test)]
+pub(crate) use batch_choice::unit_numbers;
 pub(crate) use force_loop::{RestLookup, ScatterArgs, Window};
 pub(crate) use run_loop::{MAX_OFFSETS, RUN_CHUNK, Run, RunArgs};
 
@@ -244,16 +246,23 @@ pub(crate) mod tests {
     use crate::particles::Vec3;
     use crate::spring::{Spring, SpringKind};
 
+    /// Each vector's components as bits, for comparing results to the bit.
+    pub(crate) fn bits(a: &[Vec3]) -> Vec<[u64; 3]> {
+        a.iter().map(|f| f.map(f64::to_bits).into()).collect()
+    }
+
+    /// A rayon pool of `threads` threads.
+    pub(crate) fn pool(threads: usize) -> rayon::ThreadPool {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool")
+    }
+
     /// A deterministic jumble of particles and `count` springs: random ends, lengths from 0
     /// (a degenerate spring) to far stretched, and several `(ks, kd)` pairs or just one.
     pub(crate) fn jumble(uniform: bool, count: usize) -> (Vec<Vec3>, Vec<Vec3>, Vec<Spring>) {
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = batch_choice::unit_numbers(0x2545_f491_4f6c_dd1d);
         let n = 3000;
         let mut x: Vec<Vec3> = (0..n).map(|_| Vec3::new(next(), next(), next())).collect();
         x[1] = x[0];
@@ -399,13 +408,7 @@ pub(crate) mod tests {
         uniform: bool,
     ) -> (Vec<Vec3>, Vec<Vec3>, Vec<Spring>) {
         let id = |i: usize, j: usize, k: usize| (i * b + j) * c + k;
-        let mut seed = 0x853c_49e6_748f_ea9b_u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = batch_choice::unit_numbers(0x853c_49e6_748f_ea9b);
         let mut x = vec![Vec3::zeros(); a * b * c];
         let mut v = x.clone();
         for i in 0..a {

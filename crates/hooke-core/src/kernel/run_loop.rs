@@ -12,10 +12,11 @@
 //! group's forces in one instruction per operation and subtract them from the window,
 //! which holds forces by component (`run_avx2.rs`, `run_avx512.rs`); the portable kernel
 //! does the same lane by lane. The lower ends of a chunk of runs sit in component layout
-//! throughout, and so do their forces until they are added to the window. The group's width is the vector's:
-//! on a core that issues a 512-bit operation at half the rate of a 256-bit one, eight
-//! springs per instruction still halve the instructions waiting on each square root and
-//! division, which is what bounds a group's overlap with the next.
+//! throughout, and so do their forces until they are added to the window. Which width
+//! is faster on a core with both depends on more than the instruction set: eight springs
+//! per instruction halve the instructions waiting on each square root and division, but
+//! a core may issue two 256-bit operations where it issues one 512-bit one, so the
+//! AVX-512 kernel times both (`batch_choice.rs`).
 
 use super::force_loop::RestLookup;
 use crate::spring::spring_formula;
