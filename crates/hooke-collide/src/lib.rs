@@ -37,7 +37,7 @@ pub use box_interior::{BOX_FACES, BoxInterior};
 pub use cylinder::Cylinder;
 pub use obj::{MeshError, MeshPart, Placement, load_obj, parse_obj};
 pub use plane::Plane;
-pub use trimesh::{TriMeshCollider, closedness_defect};
+pub use trimesh::{TriMeshCollider, closedness_defect, signed_volume};
 
 use std::path::Path;
 

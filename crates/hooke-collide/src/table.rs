@@ -165,7 +165,7 @@ pub fn square_table_obj() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Placement, closedness_defect, parse_obj};
+    use crate::{Placement, closedness_defect, parse_obj, signed_volume};
     use std::path::Path;
 
     fn shipped(name: &str) -> String {
@@ -201,14 +201,7 @@ mod tests {
                     part.name
                 );
                 // Outward: the signed volume (divergence theorem) is positive.
-                let volume: f64 = part
-                    .triangles
-                    .iter()
-                    .map(|t| {
-                        let [a, b, c] = t.map(|i| part.vertices[i as usize]);
-                        a.dot(&b.cross(&c)) / 6.0
-                    })
-                    .sum();
+                let volume = signed_volume(&part.vertices, &part.triangles);
                 assert!(
                     volume > 0.0,
                     "{} has inward faces (volume {volume})",

@@ -36,7 +36,8 @@ struct Part {
 /// A collider made of the objects of one OBJ file.
 ///
 /// Closed parts are solids: a point inside gets the nearest surface point and the outward
-/// normal there (from parry's pseudo-normals). Open parts are thin sheets and only catch
+/// normal there (from parry's pseudo-normals). A closed part that is inside out (its faces
+/// wound clockwise seen from outside) is turned outward, shell by shell. Open parts are thin sheets and only catch
 /// crossings. Every part catches crossings, so a fast particle cannot tunnel through a thin
 /// closed part either.
 #[derive(Clone, Debug)]
@@ -53,19 +54,76 @@ fn from_parry(v: PVec) -> Vec3 {
     Vec3::new(v.x, v.y, v.z)
 }
 
-/// Why a part is not a closed, consistently oriented surface, if it is not: every directed
-/// edge must appear once and its reverse once.
-pub fn closedness_defect(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Option<String> {
-    // Weld exactly equal positions: OBJ files repeat vertices per face group.
+/// One id per distinct position: OBJ files repeat vertices per face group, and the
+/// copies of one corner must count as one.
+fn welded(vertices: &[Vec3]) -> Vec<u32> {
     let mut weld: HashMap<[u64; 3], u32> = HashMap::new();
-    let ids: Vec<u32> = vertices
+    vertices
         .iter()
         .map(|v| {
             let key = [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
             let next = weld.len() as u32;
             *weld.entry(key).or_insert(next)
         })
+        .collect()
+}
+
+/// The volume a closed, consistently oriented surface encloses (the divergence theorem):
+/// positive when its faces wind counter-clockwise seen from outside, negative when the
+/// surface is inside out.
+pub fn signed_volume(vertices: &[Vec3], triangles: &[[u32; 3]]) -> f64 {
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| vertices[i as usize]);
+            a.dot(&b.cross(&c)) / 6.0
+        })
+        .sum()
+}
+
+/// `triangles`, a closed, consistently oriented surface, with every shell (triangles
+/// joined through shared corners) that encloses a negative volume turned outward, its
+/// triangles' winding reversed. Exporters write inside-out solids now and then (flipped
+/// normals); read as they are, everything outside such a table would be inside it, and a
+/// cloth above it would be pulled through its top.
+fn outward(vertices: &[Vec3], mut triangles: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
+    let ids = welded(vertices);
+    // Union-find over welded corners.
+    let mut parent: Vec<u32> = (0..ids.len() as u32).collect();
+    fn root(parent: &mut [u32], mut k: u32) -> u32 {
+        while parent[k as usize] != k {
+            parent[k as usize] = parent[parent[k as usize] as usize];
+            k = parent[k as usize];
+        }
+        k
+    }
+    for t in &triangles {
+        let a = root(&mut parent, ids[t[0] as usize]);
+        for &i in &t[1..] {
+            let b = root(&mut parent, ids[i as usize]);
+            parent[b as usize] = a;
+        }
+    }
+    let shell: Vec<u32> = triangles
+        .iter()
+        .map(|t| root(&mut parent, ids[t[0] as usize]))
         .collect();
+    let mut volume: HashMap<u32, f64> = HashMap::new();
+    for (t, &s) in triangles.iter().zip(&shell) {
+        *volume.entry(s).or_default() += signed_volume(vertices, std::slice::from_ref(t));
+    }
+    for (t, s) in triangles.iter_mut().zip(&shell) {
+        if volume[s] < 0.0 {
+            t.swap(1, 2);
+        }
+    }
+    triangles
+}
+
+/// Why a part is not a closed, consistently oriented surface, if it is not: every directed
+/// edge must appear once and its reverse once.
+pub fn closedness_defect(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Option<String> {
+    let ids = welded(vertices);
     let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
     for t in triangles {
         for k in 0..3 {
@@ -127,8 +185,13 @@ impl TriMeshCollider {
             if closed {
                 flags |= TriMeshFlags::ORIENTED;
             }
+            let triangles = if closed {
+                outward(&part.vertices, part.triangles)
+            } else {
+                part.triangles
+            };
             let vertices = part.vertices.iter().map(to_parry).collect();
-            let mesh = ParryMesh::with_flags(vertices, part.triangles, flags).map_err(|e| {
+            let mesh = ParryMesh::with_flags(vertices, triangles, flags).map_err(|e| {
                 MeshError::Build {
                     path: path.to_path_buf(),
                     part: part.name.clone(),
@@ -398,5 +461,76 @@ impl Collider for TriMeshCollider {
                 point,
             }
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit cube from the origin, its faces wound outward, as two shells when `two`
+    /// (the second 2 m along x).
+    fn cubes(two: bool) -> MeshPart {
+        let mut vertices = Vec::new();
+        let mut triangles = Vec::new();
+        for shift in if two { &[0.0, 2.0][..] } else { &[0.0][..] } {
+            let base = vertices.len() as u32;
+            for k in 0..8 {
+                let c = |bit: u32| f64::from((k >> bit) & 1);
+                vertices.push(Vec3::new(c(2) + shift, c(1), c(0)));
+            }
+            for q in crate::BOX_FACES {
+                let q = q.map(|i| base + i as u32);
+                triangles.push([q[0], q[1], q[2]]);
+                triangles.push([q[0], q[2], q[3]]);
+            }
+        }
+        MeshPart {
+            name: "cubes".into(),
+            vertices,
+            triangles,
+        }
+    }
+
+    /// An inside-out solid (every shell, or one of two) answers as the outward one does: a
+    /// point above it is clear of it, and a point just under its top is pushed up through
+    /// the top.
+    #[test]
+    fn an_inside_out_solid_is_turned_outward() {
+        for two in [false, true] {
+            let outward = cubes(two);
+            assert!(signed_volume(&outward.vertices, &outward.triangles) > 0.0);
+            let mut inverted = outward.clone();
+            for t in &mut inverted.triangles {
+                t.swap(1, 2);
+            }
+            let mut one_inverted = outward.clone();
+            for t in &mut one_inverted.triangles[12..] {
+                t.swap(1, 2);
+            }
+            let mut cases = vec![("outward", outward), ("inside out", inverted)];
+            if two {
+                cases.push(("one shell inside out", one_inverted));
+            }
+            for (name, part) in cases {
+                let path = Path::new("cubes.obj");
+                let collider = TriMeshCollider::new("cubes", vec![part], path, true).unwrap();
+                for x in if two { &[0.5, 2.5][..] } else { &[0.5][..] } {
+                    let mut above = Vec::new();
+                    collider.contacts(&Vec3::new(*x, 1.5, 0.5), &mut |c| above.push(c));
+                    assert!(above.is_empty(), "{name}, two {two}: a point above touches");
+                    let mut under = Vec::new();
+                    collider.contacts(&Vec3::new(*x, 0.9, 0.5), &mut |c| under.push(c));
+                    assert_eq!(under.len(), 1, "{name}, two {two}: under the top");
+                    let c = under[0];
+                    assert!(
+                        (c.depth - 0.1).abs() < 1e-12 && (c.normal - Vec3::y()).norm() < 1e-12,
+                        "{name}, two {two}: depth {} normal {:?}",
+                        c.depth,
+                        c.normal
+                    );
+                }
+            }
+        }
     }
 }
