@@ -37,7 +37,8 @@ pub(super) fn sum_windows<'a>(
     start: usize,
     out: &mut [Vec3],
 ) {
-    out.fill(Vec3::zeros());
+    // As plain values: filling with `Vec3::zeros()` stored one component at a time.
+    bytemuck::cast_slice_mut::<Vec3, f64>(out).fill(0.0);
     for part in parts {
         part.add_to(start, out);
     }

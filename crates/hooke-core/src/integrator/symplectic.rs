@@ -6,6 +6,7 @@
 //! the start positions are copied aside as it goes only for a model with a contact phase.
 
 use super::{StepReport, Workspace};
+use crate::kernel::Advance;
 use crate::model::Model;
 use crate::parallel;
 use crate::particles::{Particles, SANE_BOUND, Vec3};
@@ -47,26 +48,33 @@ fn update<const GRAVITY_ONLY: bool>(
 ) -> bool {
     let air = ws.air.evaluate(model, &p.x, &p.v, t);
     let (mass, inv_mass) = (&p.mass[..], &p.inv_mass[..]);
+    let kernel = ws.assembly.kernel();
     let finish = |start: usize, springs: &[Vec3], x: &mut [Vec3], v: &mut [Vec3]| {
         let n = springs.len().min(x.len()).min(v.len());
         let (mass, inv_mass) = (&mass[start..start + n], &inv_mass[start..start + n]);
+        if GRAVITY_ONLY {
+            let advance = Advance {
+                mass,
+                inv_mass,
+                gravity: model.gravity,
+                dt,
+                bound: SANE_BOUND,
+            };
+            return kernel.advance(&advance, &springs[..n], x, v);
+        }
         for k in 0..n {
             // A pinned particle keeps its state.
             if inv_mass[k] == 0.0 {
                 continue;
             }
             let (xk, vk) = (x[k], v[k]);
-            let f = if GRAVITY_ONLY {
-                model.gravity * mass[k] + springs[k]
+            // Without air nothing is added, so vacuum runs keep every bit.
+            let pairwise = if air.is_empty() {
+                springs[k]
             } else {
-                // Without air nothing is added, so vacuum runs keep every bit.
-                let pairwise = if air.is_empty() {
-                    springs[k]
-                } else {
-                    springs[k] + air[start + k]
-                };
-                model.total_force(start + k, mass[k], &xk, &vk, pairwise)
+                springs[k] + air[start + k]
             };
+            let f = model.total_force(start + k, mass[k], &xk, &vk, pairwise);
             v[k] = vk + f * inv_mass[k] * dt;
             x[k] = xk + v[k] * dt;
         }

@@ -6,16 +6,20 @@
 //! baseline x86-64 (2 lanes), so the loop is compiled again for AVX2 and AVX-512 and the
 //! widest the CPU supports is picked at run time. Portable and AVX2 builds batch springs
 //! by component (`ComponentBatch`, see `spring.rs`); the AVX-512 build times both layouts
-//! once per process and keeps the faster (`batch_choice.rs`). This module is the
-//! workspace's one use of `unsafe`: calling functions compiled for features that were
-//! checked to be present.
+//! once per process and keeps the faster (`batch_choice.rs`). The symplectic update of
+//! particles moved by springs and gravity alone is compiled per kernel too (`advance.rs`).
+//! Its `unsafe` is calling functions compiled for features that were checked to be
+//! present (the one other use in the workspace is the one-pass step's shared state,
+//! `assembly/fused.rs`).
 
+mod advance;
 mod batch_choice;
 mod force_loop;
 mod run_avx2;
 mod run_avx512;
 mod run_loop;
 
+pub(crate) use advance::Advance;
 pub(crate) use batch_choice::BatchLayout;
 #[cfg(target_arch = "x86_64")]
 use batch_choice::RunWidth;
@@ -24,6 +28,7 @@ pub(crate) use batch_choice::unit_numbers;
 pub(crate) use force_loop::{RestLookup, ScatterArgs, Window};
 pub(crate) use run_loop::{MAX_OFFSETS, RUN_CHUNK, Run, RunArgs};
 
+use crate::particles::Vec3;
 use crate::spring::{ComponentBatch, VectorBatch};
 use force_loop::{LANES, scatter_springs};
 use run_loop::{GROUP, group_by_lane, scatter_runs};
@@ -182,6 +187,31 @@ impl Kernel {
             },
             #[cfg(not(target_arch = "x86_64"))]
             _ => scatter_runs::<UNIFORM, R, GROUP>(args, group_by_lane),
+        }
+    }
+}
+
+impl Kernel {
+    /// Runs the symplectic update of particles moved by springs (`springs`, their forces)
+    /// and gravity alone compiled for this kernel (see `advance.rs`): updates `x` and `v`
+    /// in place and returns whether the new state is sane.
+    #[allow(unsafe_code)]
+    pub(crate) fn advance(
+        self,
+        a: &Advance,
+        springs: &[Vec3],
+        x: &mut [Vec3],
+        v: &mut [Vec3],
+    ) -> bool {
+        match self.min(Self::detect()) {
+            Self::Portable => advance::advance_portable(a, springs, x, v),
+            // SAFETY: as in `scatter`.
+            #[cfg(target_arch = "x86_64")]
+            Self::Avx2 => unsafe { advance::advance_avx2(a, springs, x, v) },
+            #[cfg(target_arch = "x86_64")]
+            Self::Avx512 => unsafe { advance::advance_avx512(a, springs, x, v) },
+            #[cfg(not(target_arch = "x86_64"))]
+            _ => advance::advance_portable(a, springs, x, v),
         }
     }
 }
