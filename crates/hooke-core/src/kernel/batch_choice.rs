@@ -9,8 +9,10 @@
 //! keeps the faster for the rest of the process. The run loop's groups likewise: eight
 //! springs in 512-bit registers or four in 256-bit ones, which on an Intel Xeon with
 //! AVX-512 ran cloth-1024 about 5 % faster (two 256-bit operations issue where one 512-bit
-//! one does, and the square root and division cost no more per lane). The choices change
-//! speed, never a result.
+//! one does, and the square root and division cost no more per lane). The per-spring loop
+//! is timed compiled for AVX2 too (component batches in 256-bit registers): on the same
+//! Xeon it ran a `jello.w` RK4 step 15 % faster than either AVX-512 layout (7.55k against
+//! 6.5k steps/s on one thread). The choices change speed, never a result.
 
 use super::force_loop::{LANES, ScatterArgs, scatter_springs};
 use super::run_loop::{Run, RunArgs};
@@ -26,6 +28,8 @@ pub(crate) enum BatchLayout {
     Component,
     /// Each vector whole ([`VectorBatch`]).
     Vector,
+    /// One array per component, in the AVX2 kernel's loop (256-bit registers).
+    Narrow,
 }
 
 /// The layout the AVX-512 loop uses in this process: measured on first use.
@@ -56,19 +60,20 @@ pub(crate) fn unit_numbers(mut seed: u64) -> impl FnMut() -> f64 {
     }
 }
 
-/// Whether `second` is the faster of two ways of doing one job, `pass(false)` timing the
-/// first and `pass(true)` the second: nine interleaved rounds and the best of each, as a
-/// neighbour's burst slows some passes of both, not all of one.
-fn second_is_faster(mut pass: impl FnMut(bool) -> Duration) -> bool {
-    let mut best = [Duration::MAX; 2];
+/// Which of `N` ways of doing one job is the fastest, `pass(k)` timing way `k`: nine
+/// interleaved rounds and the best of each, as a neighbour's burst slows some passes of
+/// all, not all of one. Ties go to the earlier way.
+fn fastest<const N: usize>(mut pass: impl FnMut(usize) -> Duration) -> usize {
+    let mut best = [Duration::MAX; N];
     for _ in 0..9 {
-        best[0] = best[0].min(pass(false));
-        best[1] = best[1].min(pass(true));
+        for (k, best) in best.iter_mut().enumerate() {
+            *best = (*best).min(pass(k));
+        }
     }
-    best[1] < best[0]
+    (0..N).min_by_key(|&k| best[k]).unwrap_or(0)
 }
 
-/// Times both layouts and returns the one with the faster best pass.
+/// Times the three layouts and returns the one with the fastest best pass.
 #[allow(unsafe_code)]
 unsafe fn faster_layout() -> BatchLayout {
     let mut next = unit_numbers(0x2545_f491_4f6c_dd1d);
@@ -84,7 +89,12 @@ unsafe fn faster_layout() -> BatchLayout {
         .collect();
     let rest = vec![0.1; ends.len()];
     let mut force = vec![Vec3::zeros(); PARTICLES];
-    let pass = |vector: bool| {
+    const LAYOUTS: [BatchLayout; 3] = [
+        BatchLayout::Component,
+        BatchLayout::Vector,
+        BatchLayout::Narrow,
+    ];
+    let pass = |k: usize| {
         let args = ScatterArgs {
             springs: &ends[..],
             rest: &rest[..],
@@ -98,19 +108,16 @@ unsafe fn faster_layout() -> BatchLayout {
         let start = Instant::now();
         // SAFETY: passed on from the caller.
         unsafe {
-            if vector {
-                timed::<VectorBatch<LANES>>(args)
-            } else {
-                timed::<ComponentBatch<LANES>>(args)
+            match LAYOUTS[k] {
+                BatchLayout::Component => timed::<ComponentBatch<LANES>>(args),
+                BatchLayout::Vector => timed::<VectorBatch<LANES>>(args),
+                // Called from here, not from an AVX-512 function that could inline it.
+                BatchLayout::Narrow => super::scatter_avx2::<true, &[f64]>(args),
             }
         }
         start.elapsed()
     };
-    if second_is_faster(pass) {
-        BatchLayout::Vector
-    } else {
-        BatchLayout::Component
-    }
+    LAYOUTS[fastest::<3>(pass)]
 }
 
 /// The per-spring loop compiled for AVX-512 with batch layout `B`.
@@ -213,22 +220,14 @@ unsafe fn run_pass(width: RunWidth, grid: &RunGrid, force: &mut [f64]) {
 unsafe fn faster_run_width() -> RunWidth {
     let grid = run_grid(1);
     let mut force = vec![0.0; 3 * grid.x.len()];
-    let pass = |four: bool| {
-        let width = if four {
-            RunWidth::Four
-        } else {
-            RunWidth::Eight
-        };
+    let pass = |k: usize| {
+        let width = [RunWidth::Eight, RunWidth::Four][k];
         let start = Instant::now();
         // SAFETY: passed on from the caller.
         unsafe { run_pass(width, &grid, &mut force) };
         start.elapsed()
     };
-    if second_is_faster(pass) {
-        RunWidth::Four
-    } else {
-        RunWidth::Eight
-    }
+    [RunWidth::Eight, RunWidth::Four][fastest::<2>(pass)]
 }
 
 #[cfg(test)]

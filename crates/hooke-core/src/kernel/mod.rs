@@ -6,7 +6,7 @@
 //! baseline x86-64 (2 lanes), so the loop is compiled again for AVX2 and AVX-512 and the
 //! widest the CPU supports is picked at run time. Portable and AVX2 builds batch springs
 //! by component (`ComponentBatch`, see `spring.rs`); the AVX-512 build times both layouts
-//! once per process and keeps the faster (`batch_choice.rs`). The symplectic update of
+//! and the AVX2 loop once per process and keeps the fastest (`batch_choice.rs`). The symplectic update of
 //! particles moved by springs and gravity alone is compiled per kernel too (`advance.rs`).
 //! Its `unsafe` is calling functions compiled for features that were checked to be
 //! present (the one other use in the workspace is the one-pass step's shared state,
@@ -115,9 +115,9 @@ impl Kernel {
     }
 
     /// How this kernel's per-spring loop batches springs: `"component"` (one array per
-    /// component) or `"vector"` (each vector whole). The AVX-512 kernel times both once per
-    /// process on first use and keeps the faster; the others always batch by component.
-    /// Both give the same bits.
+    /// component), `"vector"` (each vector whole) or `"256-bit component"` (the AVX2
+    /// kernel's loop). The AVX-512 kernel times the three once per process on first use and
+    /// keeps the fastest; the others always batch by component. All give the same bits.
     #[allow(unsafe_code)]
     pub fn batches(self) -> &'static str {
         let layout = match self.min(Self::detect()) {
@@ -129,6 +129,7 @@ impl Kernel {
         match layout {
             BatchLayout::Component => "component",
             BatchLayout::Vector => "vector",
+            BatchLayout::Narrow => "256-bit component",
         }
     }
 
@@ -145,14 +146,14 @@ impl Kernel {
             Self::Avx2 => unsafe { scatter_avx2::<UNIFORM, R>(args) },
             #[cfg(target_arch = "x86_64")]
             Self::Avx512 => unsafe {
-                scatter_avx512::<UNIFORM, R>(batch_choice::avx512_layout(), args)
+                scatter_avx512_in::<UNIFORM, R>(batch_choice::avx512_layout(), args)
             },
             #[cfg(not(target_arch = "x86_64"))]
             _ => scatter_springs::<UNIFORM, R, ComponentBatch<LANES>>(args),
         }
     }
 
-    /// [`Kernel::scatter`] with the AVX-512 loop's batch layout given, for tests of both.
+    /// [`Kernel::scatter`] with the AVX-512 loop's batch layout given, for tests of each.
     #[cfg(test)]
     #[allow(unsafe_code)]
     pub(crate) fn scatter_with<const UNIFORM: bool, R: RestLookup>(
@@ -163,7 +164,7 @@ impl Kernel {
         match self.min(Self::detect()) {
             // SAFETY: as in `scatter`.
             #[cfg(target_arch = "x86_64")]
-            Self::Avx512 => unsafe { scatter_avx512::<UNIFORM, R>(layout, args) },
+            Self::Avx512 => unsafe { scatter_avx512_in::<UNIFORM, R>(layout, args) },
             other => other.scatter::<UNIFORM, R>(args),
         }
     }
@@ -241,16 +242,40 @@ impl FromStr for Kernel {
 /// The spring force loop compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn scatter_avx2<const UNIFORM: bool, R: RestLookup>(args: ScatterArgs<R>) {
+pub(crate) fn scatter_avx2<const UNIFORM: bool, R: RestLookup>(args: ScatterArgs<R>) {
     scatter_springs::<UNIFORM, R, ComponentBatch<LANES>>(args);
 }
 
-/// The spring force loop compiled for AVX-512, with batches in `layout`.
+/// The AVX-512 kernel's per-spring loop in `layout`: the AVX2 compilation for
+/// [`BatchLayout::Narrow`], called from here and not from an AVX-512 function, which could
+/// inline it and compile it for AVX-512 after all.
+///
+/// # Safety
+/// The CPU must support AVX-512F, AVX-512VL and AVX2.
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+unsafe fn scatter_avx512_in<const UNIFORM: bool, R: RestLookup>(
+    layout: BatchLayout,
+    args: ScatterArgs<R>,
+) {
+    // SAFETY: passed on from the caller.
+    unsafe {
+        match layout {
+            BatchLayout::Narrow => scatter_avx2::<UNIFORM, R>(args),
+            _ => scatter_avx512::<UNIFORM, R>(layout, args),
+        }
+    }
+}
+
+/// The spring force loop compiled for AVX-512, with batches in `layout` (component batches
+/// for [`BatchLayout::Narrow`], which `scatter_avx512_in` sends elsewhere).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx2")]
 fn scatter_avx512<const UNIFORM: bool, R: RestLookup>(layout: BatchLayout, args: ScatterArgs<R>) {
     match layout {
-        BatchLayout::Component => scatter_springs::<UNIFORM, R, ComponentBatch<LANES>>(args),
+        BatchLayout::Component | BatchLayout::Narrow => {
+            scatter_springs::<UNIFORM, R, ComponentBatch<LANES>>(args)
+        }
         BatchLayout::Vector => scatter_springs::<UNIFORM, R, VectorBatch<LANES>>(args),
     }
 }
@@ -423,7 +448,12 @@ pub(crate) mod tests {
         };
         let portable = forces(Kernel::Portable, BatchLayout::Component);
         assert!(portable.iter().any(|&b| b != 0), "the springs pull");
-        for layout in [BatchLayout::Component, BatchLayout::Vector] {
+        let layouts = [
+            BatchLayout::Component,
+            BatchLayout::Vector,
+            BatchLayout::Narrow,
+        ];
+        for layout in layouts {
             assert!(forces(Kernel::Avx512, layout) == portable, "{layout:?}");
         }
     }
