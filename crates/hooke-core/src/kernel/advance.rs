@@ -64,6 +64,35 @@ mod x86 {
         _mm512_set1_pd,
     };
 
+    /// Runs `block(springs, x, v, mass, inv_mass)` on each whole block of `L` particles,
+    /// their forces, positions and velocities as flat values, then the portable loop on the
+    /// particles left; returns the portable loop's verdict.
+    #[inline(always)]
+    fn blocks<const L: usize>(
+        a: &Advance,
+        springs: &[Vec3],
+        x: &mut [Vec3],
+        v: &mut [Vec3],
+        mut block: impl FnMut(&[f64], &mut [f64], &mut [f64], &[f64], &[f64]),
+    ) -> bool {
+        let wide = springs.len() / L * L;
+        for k in (0..wide).step_by(L) {
+            block(
+                bytemuck::cast_slice(&springs[k..k + L]),
+                bytemuck::cast_slice_mut(&mut x[k..k + L]),
+                bytemuck::cast_slice_mut(&mut v[k..k + L]),
+                &a.mass[k..k + L],
+                &a.inv_mass[k..k + L],
+            );
+        }
+        let rest = Advance {
+            mass: &a.mass[wide..],
+            inv_mass: &a.inv_mass[wide..],
+            ..*a
+        };
+        advance_portable(&rest, &springs[wide..], &mut x[wide..], &mut v[wide..])
+    }
+
     /// Particles per pass of the AVX-512 loop: their 24 coordinates fill three registers.
     const WIDE: usize = 8;
 
@@ -89,8 +118,6 @@ mod x86 {
         x: &mut [Vec3],
         v: &mut [Vec3],
     ) -> bool {
-        let n = springs.len();
-        let wide = n - n % WIDE;
         let load = |v: &[f64]| -> __m512d {
             bytemuck::cast::<[f64; WIDE], _>(v.try_into().expect("eight"))
         };
@@ -99,11 +126,8 @@ mod x86 {
         let (dt, bound) = (_mm512_set1_pd(a.dt), _mm512_set1_pd(a.bound));
         let (zero, infinity) = (_mm512_set1_pd(0.0), _mm512_set1_pd(f64::INFINITY));
         let mut ok = u8::MAX;
-        for k in (0..wide).step_by(WIDE) {
-            let s: &[f64] = bytemuck::cast_slice(&springs[k..k + WIDE]);
-            let xs: &mut [f64] = bytemuck::cast_slice_mut(&mut x[k..k + WIDE]);
-            let vs: &mut [f64] = bytemuck::cast_slice_mut(&mut v[k..k + WIDE]);
-            let (m, inv) = (load(&a.mass[k..k + WIDE]), load(&a.inv_mass[k..k + WIDE]));
+        let rest = blocks::<WIDE>(a, springs, x, v, |s, xs, vs, m, inv| {
+            let (m, inv) = (load(m), load(inv));
             for r in 0..3 {
                 let lanes = 8 * r..8 * r + 8;
                 let (mr, ir) = (
@@ -124,17 +148,7 @@ mod x86 {
                 xs[lanes.clone()].copy_from_slice(&bytemuck::cast::<_, [f64; WIDE]>(x1));
                 vs[lanes].copy_from_slice(&bytemuck::cast::<_, [f64; WIDE]>(v1));
             }
-        }
-        let rest = advance_portable(
-            &Advance {
-                mass: &a.mass[wide..],
-                inv_mass: &a.inv_mass[wide..],
-                ..*a
-            },
-            &springs[wide..],
-            &mut x[wide..],
-            &mut v[wide..],
-        );
+        });
         (ok == u8::MAX) & rest
     }
 
@@ -160,8 +174,6 @@ mod x86 {
         x: &mut [Vec3],
         v: &mut [Vec3],
     ) -> bool {
-        let n = springs.len();
-        let wide = n - n % GROUP;
         let load = |v: &[f64]| -> __m256d {
             bytemuck::cast::<[f64; GROUP], _>(v.try_into().expect("four"))
         };
@@ -170,12 +182,8 @@ mod x86 {
         let (zero, infinity) = (_mm256_set1_pd(0.0), _mm256_set1_pd(f64::INFINITY));
         let sign = _mm256_set1_pd(-0.0);
         let mut ok = _mm256_cmp_pd::<_CMP_LE_OQ>(zero, zero);
-        for k in (0..wide).step_by(GROUP) {
-            let s: &[f64] = bytemuck::cast_slice(&springs[k..k + GROUP]);
-            let xs: &mut [f64] = bytemuck::cast_slice_mut(&mut x[k..k + GROUP]);
-            let vs: &mut [f64] = bytemuck::cast_slice_mut(&mut v[k..k + GROUP]);
-            let m = spread4(load(&a.mass[k..k + GROUP]));
-            let inv = spread4(load(&a.inv_mass[k..k + GROUP]));
+        let rest = blocks::<GROUP>(a, springs, x, v, |s, xs, vs, m, inv| {
+            let (m, inv) = (spread4(load(m)), spread4(load(inv)));
             for r in 0..3 {
                 let lanes = 4 * r..4 * r + 4;
                 let moves = _mm256_cmp_pd::<_CMP_NEQ_UQ>(inv[r], zero);
@@ -193,17 +201,7 @@ mod x86 {
                 xs[lanes.clone()].copy_from_slice(&bytemuck::cast::<_, [f64; GROUP]>(x1));
                 vs[lanes].copy_from_slice(&bytemuck::cast::<_, [f64; GROUP]>(v1));
             }
-        }
-        let rest = advance_portable(
-            &Advance {
-                mass: &a.mass[wide..],
-                inv_mass: &a.inv_mass[wide..],
-                ..*a
-            },
-            &springs[wide..],
-            &mut x[wide..],
-            &mut v[wide..],
-        );
+        });
         (_mm256_movemask_pd(ok) == 0b1111) & rest
     }
 }
