@@ -192,14 +192,15 @@ impl Partition {
         bytemuck::cast_slice_mut(&mut self.force[..3 * self.len])
     }
 
-    /// Zeroes the window.
+    /// Zeroes the window (as plain values: a fill with `Vec3::zeros()` stores one component
+    /// at a time).
     fn clear(&mut self) {
         if self.by_component() {
             for c in self.window_mut() {
                 c.fill(0.0);
             }
         } else {
-            self.whole_mut().fill(Vec3::zeros());
+            self.force[..3 * self.len].fill(0.0);
         }
     }
 
@@ -251,6 +252,16 @@ impl Partition {
     /// The stretch of `(x, v)` the window covers: what [`scatter_partition`] reads.
     fn read<'a>(&self, (x, v): (&'a [Vec3], &'a [Vec3])) -> (&'a [Vec3], &'a [Vec3]) {
         (&x[self.lo..self.hi()], &v[self.lo..self.hi()])
+    }
+}
+
+/// Adds into `out` (particles `start..`, zeroed first) the windows of `parts` that hold
+/// them, in the order given.
+fn sum_windows<'a>(parts: impl Iterator<Item = &'a Partition>, start: usize, out: &mut [Vec3]) {
+    // As plain values: filling with `Vec3::zeros()` stored one component at a time.
+    bytemuck::cast_slice_mut::<Vec3, f64>(out).fill(0.0);
+    for part in parts {
+        part.add_to(start, out);
     }
 }
 
@@ -658,10 +669,12 @@ impl Assembly {
     /// do no window lookups.
     pub(crate) fn gather_block(&self, start: usize, out: &mut [Vec3]) {
         debug_assert!(start.is_multiple_of(REDUCE_BLOCK) && out.len() <= REDUCE_BLOCK);
-        out.fill(Vec3::zeros());
-        for &q in self.block_parts(start / REDUCE_BLOCK) {
-            self.partitions[q as usize].add_to(start, out);
-        }
+        let parts = self.block_parts(start / REDUCE_BLOCK);
+        sum_windows(
+            parts.iter().map(|&q| &self.partitions[q as usize]),
+            start,
+            out,
+        );
     }
 
     /// Scatters at `(x, v)`, then sets `out[p] = map(p, F_p)` for every particle, `F_p` its

@@ -16,7 +16,7 @@
 //! sum adds the same windows in the same order as [`Assembly::gather_block`], whatever the
 //! grouping: the bits do not depend on the thread count.
 
-use super::{Assembly, Partition, REDUCE_BLOCK, scatter_partition};
+use super::{Assembly, Partition, REDUCE_BLOCK, scatter_partition, sum_windows};
 use crate::particles::Vec3;
 use std::marker::PhantomData;
 use std::ops::Range;
@@ -29,20 +29,6 @@ pub(crate) trait Finish:
 {
 }
 impl<F: Fn(usize, &[Vec3], &mut [Vec3], &mut [Vec3]) -> bool + Sync> Finish for F {}
-
-/// Adds into `out` (particles `start..`, zeroed first) the windows of `parts` that hold
-/// them, in the order given.
-pub(super) fn sum_windows<'a>(
-    parts: impl Iterator<Item = &'a Partition>,
-    start: usize,
-    out: &mut [Vec3],
-) {
-    // As plain values: filling with `Vec3::zeros()` stored one component at a time.
-    bytemuck::cast_slice_mut::<Vec3, f64>(out).fill(0.0);
-    for part in parts {
-        part.add_to(start, out);
-    }
-}
 
 /// Gives partition `k` of a group the buffer of partition `k - 2`, whose window no stretch
 /// left to finish reads (the stretches it holds, `k - 2` and `k - 1`, are finished), when

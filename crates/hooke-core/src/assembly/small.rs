@@ -17,8 +17,7 @@
 //! partition order, as [`Assembly::gather_block`] does: the cuts and the claims move work
 //! between threads, never a bit of a result.
 
-use super::fused::sum_windows;
-use super::{Assembly, Partition, REDUCE_BLOCK, scatter_partition};
+use super::{Assembly, Partition, REDUCE_BLOCK, scatter_partition, sum_windows};
 use crate::particles::Vec3;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
