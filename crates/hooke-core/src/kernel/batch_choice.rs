@@ -14,10 +14,9 @@
 //! Xeon it ran a `jello.w` RK4 step 15 % faster than either AVX-512 layout (7.55k against
 //! 6.5k steps/s on one thread). The choices change speed, never a result.
 
-use super::force_loop::{LANES, ScatterArgs, scatter_springs};
+use super::force_loop::ScatterArgs;
 use super::run_loop::{Run, RunArgs};
 use crate::particles::Vec3;
-use crate::spring::{ComponentBatch, SpringBatch, VectorBatch};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
@@ -107,23 +106,10 @@ unsafe fn faster_layout() -> BatchLayout {
         };
         let start = Instant::now();
         // SAFETY: passed on from the caller.
-        unsafe {
-            match LAYOUTS[k] {
-                BatchLayout::Component => timed::<ComponentBatch<LANES>>(args),
-                BatchLayout::Vector => timed::<VectorBatch<LANES>>(args),
-                // Called from here, not from an AVX-512 function that could inline it.
-                BatchLayout::Narrow => super::scatter_avx2::<true, &[f64]>(args),
-            }
-        }
+        unsafe { super::scatter_avx512_in::<true, &[f64]>(LAYOUTS[k], args) };
         start.elapsed()
     };
     LAYOUTS[fastest::<3>(pass)]
-}
-
-/// The per-spring loop compiled for AVX-512 with batch layout `B`.
-#[target_feature(enable = "avx512f,avx512vl,avx2")]
-fn timed<B: SpringBatch<LANES>>(args: ScatterArgs<&[f64]>) {
-    scatter_springs::<true, &[f64], B>(args);
 }
 
 /// How many springs the AVX-512 run loop computes per group.

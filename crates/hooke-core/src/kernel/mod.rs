@@ -6,8 +6,9 @@
 //! baseline x86-64 (2 lanes), so the loop is compiled again for AVX2 and AVX-512 and the
 //! widest the CPU supports is picked at run time. Portable and AVX2 builds batch springs
 //! by component (`ComponentBatch`, see `spring.rs`); the AVX-512 build times both layouts
-//! and the AVX2 loop once per process and keeps the fastest (`batch_choice.rs`). The symplectic update of
-//! particles moved by springs and gravity alone is compiled per kernel too (`advance.rs`).
+//! and the AVX2 loop once per process and keeps the fastest (`batch_choice.rs`). The
+//! symplectic update of particles moved by springs and gravity alone is compiled per
+//! kernel too (`advance.rs`).
 //! Its `unsafe` is calling functions compiled for features that were checked to be
 //! present (the one other use in the workspace is the one-pass step's shared state,
 //! `assembly/fused.rs`).
@@ -254,7 +255,7 @@ pub(crate) fn scatter_avx2<const UNIFORM: bool, R: RestLookup>(args: ScatterArgs
 /// The CPU must support AVX-512F, AVX-512VL and AVX2.
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
-unsafe fn scatter_avx512_in<const UNIFORM: bool, R: RestLookup>(
+pub(crate) unsafe fn scatter_avx512_in<const UNIFORM: bool, R: RestLookup>(
     layout: BatchLayout,
     args: ScatterArgs<R>,
 ) {
