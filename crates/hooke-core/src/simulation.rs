@@ -74,7 +74,7 @@ impl Simulation {
             }
         }
         let mut workspace = Workspace::default();
-        workspace.ensure(&model, particles.len());
+        workspace.ensure(&model, particles.len(), integrator);
         let contacts = ContactState::new(particles.len());
         let inline = particles.len() <= crate::assembly::REDUCE_BLOCK
             // One partition of springs (see `partition_size`).
@@ -179,7 +179,8 @@ impl Simulation {
             kernel,
             ..Workspace::default()
         };
-        self.workspace.ensure(&self.model, self.particles.len());
+        self.workspace
+            .ensure(&self.model, self.particles.len(), self.integrator);
         self.contacts = ContactState::new(self.particles.len());
         self.last = StepReport {
             saved_start: false,

@@ -110,7 +110,7 @@ impl Integrator {
         (t, dt): (f64, f64),
         held: &[bool],
     ) -> StepReport {
-        ws.ensure(model, particles.len());
+        ws.ensure(model, particles.len(), self);
         match self {
             Self::Euler => euler::step(model, particles, (t, dt), ws),
             Self::Symplectic => symplectic::step(model, particles, (t, dt), ws),
@@ -172,7 +172,8 @@ pub struct Workspace {
     pub(crate) assembly: Assembly,
     /// Positions at the start of the last step, when its [`StepReport::saved_start`].
     pub(crate) x0: Vec<Vec3>,
-    /// Stage derivatives: `kx` are velocities, `kv` accelerations.
+    /// Stage derivatives: `kx` are velocities, `kv` accelerations (empty for symplectic
+    /// Euler, as are `xt` and `vt`).
     pub(crate) kx: [Vec<Vec3>; 4],
     pub(crate) kv: [Vec<Vec3>; 4],
     /// A trial state for evaluating stages.
@@ -192,9 +193,10 @@ impl Workspace {
         self.implicit.iterations
     }
 
-    /// Lays out `model`'s springs and sizes the buffers for `particles` particles, unless
-    /// they already fit: on the first step, or at once from [`crate::Simulation::new`].
-    pub(crate) fn ensure(&mut self, model: &Model, particles: usize) {
+    /// Lays out `model`'s springs and sizes the buffers `integrator` uses for `particles`
+    /// particles, unless they already fit: on the first step, or at once from
+    /// [`crate::Simulation::new`].
+    pub(crate) fn ensure(&mut self, model: &Model, particles: usize, integrator: Integrator) {
         let springs = model.springs.len();
         if !self.assembly.fits(particles, springs) {
             self.assembly = Assembly::new(particles, &model.springs);
@@ -204,12 +206,20 @@ impl Workspace {
         }
         self.air.ensure(model, particles);
         let zero = Vec3::zeros();
-        for buf in [&mut self.x0, &mut self.xt, &mut self.vt]
+        self.x0.resize(particles, zero);
+        // Symplectic Euler updates the state in place and has no stages: at a million
+        // particles the ten stage buffers would be 240 MB to allocate and zero.
+        let stages = if integrator == Integrator::Symplectic {
+            0
+        } else {
+            particles
+        };
+        for buf in [&mut self.xt, &mut self.vt]
             .into_iter()
             .chain(self.kx.iter_mut())
             .chain(self.kv.iter_mut())
         {
-            buf.resize(particles, zero);
+            buf.resize(stages, zero);
         }
     }
 
