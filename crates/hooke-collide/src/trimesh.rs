@@ -37,9 +37,9 @@ struct Part {
 ///
 /// Closed parts are solids: a point inside gets the nearest surface point and the outward
 /// normal there (from parry's pseudo-normals). A closed part that is inside out (its faces
-/// wound clockwise seen from outside) is turned outward, shell by shell. Open parts are thin sheets and only catch
-/// crossings. Every part catches crossings, so a fast particle cannot tunnel through a thin
-/// closed part either.
+/// wound clockwise seen from outside) is turned outward, shell by shell. Open parts are
+/// thin sheets and only catch crossings. Every part catches crossings, so a fast particle
+/// cannot tunnel through a thin closed part either.
 #[derive(Clone, Debug)]
 pub struct TriMeshCollider {
     label: String,
