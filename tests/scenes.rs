@@ -1,4 +1,4 @@
-//! The five built-in scenes: shipped files equal the built-ins, every scene runs stable to its
+//! The seven built-in scenes: shipped files equal the built-ins, every scene runs stable to its
 //! end, and its trajectory is locked by a snapshot.
 
 use crate::common::{builtin, root, round_sig};

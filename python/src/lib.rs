@@ -16,6 +16,7 @@ use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::path::Path;
+use std::sync::{Mutex, MutexGuard, TryLockError};
 use std::time::{Duration, Instant};
 
 create_exception!(
@@ -32,9 +33,34 @@ create_exception!(
      particle and a stable step size."
 );
 
-/// A Rust error as the Python exception that says the same as the command would.
+/// The command line's option names in the library's messages, as the Python arguments
+/// that carry the same values.
+const ARGUMENT_NAMES: [(&str, &str); 10] = [
+    ("--format ply", "format=\"ply\""),
+    ("--format obj", "format=\"obj\""),
+    ("--format", "format="),
+    ("--export (its mesh)", "export (its mesh)"),
+    ("--export", "export path"),
+    ("--body", "body="),
+    ("--table", "table="),
+    ("--threads", "threads="),
+    ("--dt", "dt="),
+    ("--duration", "duration="),
+];
+
+/// `message` with the command line's option names replaced by [`ARGUMENT_NAMES`].
+fn in_python_terms(message: &str) -> String {
+    let mut out = message.to_string();
+    for (option, argument) in ARGUMENT_NAMES {
+        out = out.replace(option, argument);
+    }
+    out
+}
+
+/// A Rust error as the Python exception that says the same as the command would, in the
+/// terms of the Python call.
 fn error(e: anyhow::Error) -> PyErr {
-    let message = format!("{e:#}");
+    let message = in_python_terms(&format!("{e:#}"));
     if e.chain().any(|c| c.downcast_ref::<Divergence>().is_some()) {
         DivergenceError::new_err(message)
     } else {
@@ -46,18 +72,40 @@ fn error(e: anyhow::Error) -> PyErr {
 /// turn (so Ctrl-C interrupts a long `advance` within this time).
 const SIGNAL_CHECK: Duration = Duration::from_millis(50);
 
+/// What a second thread is told while a simulation is busy.
+const IN_USE: &str = "this Simulation is in use by another thread (stepping, rendering or \
+                      exporting); a Simulation serves one thread at a time: wait for that call \
+                      to return, or load one Simulation per thread";
+
 /// A scene being simulated: positions and velocities as numpy arrays, stepping, rendering,
-/// exporting.
-#[pyclass(module = "hooke")]
+/// exporting. One thread uses it at a time: a call from a second thread while another's
+/// runs raises `HookeError`.
+#[pyclass(module = "hooke", frozen)]
 struct Simulation {
-    scene: Scene,
+    /// The scene and its pool, held by one call at a time (its steps run without the GIL).
+    inner: Mutex<Inner>,
     /// The source it was loaded from, for its repr.
     source: String,
+}
+
+/// A simulation's state.
+struct Inner {
+    scene: Scene,
     /// A pool of the requested size, when `threads` was given; otherwise rayon's global one.
     pool: Option<rayon::ThreadPool>,
 }
 
 impl Simulation {
+    /// The state, or `HookeError` while another thread's call holds it.
+    fn lock(&self) -> PyResult<MutexGuard<'_, Inner>> {
+        match self.inner.try_lock() {
+            Ok(inner) => Ok(inner),
+            // A panic in a call leaves the scene as its last whole step left it.
+            Err(TryLockError::Poisoned(e)) => Ok(e.into_inner()),
+            Err(TryLockError::WouldBlock) => Err(HookeError::new_err(IN_USE)),
+        }
+    }
+
     /// Runs `f` on a worker of this simulation's pool, or of rayon's global one: the
     /// solver's parallel loops are then cheap joins, and a stretch of steps moves to the
     /// pool once, not once per step.
@@ -68,7 +116,9 @@ impl Simulation {
             None => rayon::join(f, || ()).0,
         }
     }
+}
 
+impl Inner {
     /// Steps `n` times with the GIL released, in stretches of at most [`SIGNAL_CHECK`];
     /// between stretches Python's signal handlers run, and a `KeyboardInterrupt` stops the
     /// run after a whole step.
@@ -102,13 +152,25 @@ impl Simulation {
         }
         Ok(())
     }
+}
 
-    /// A read-only numpy array of shape `(N, 3)` holding the vectors `v`.
-    fn matrix<'py>(py: Python<'py>, v: &[Vec3]) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let values: Vec<f64> = v.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
-        let array = PyArray1::from_vec(py, values).reshape([v.len(), 3])?;
-        read_only(array.as_any())?;
-        Ok(array)
+/// A read-only numpy array of shape `(N, 3)` holding the vectors `v`.
+fn matrix<'py>(py: Python<'py>, v: &[Vec3]) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let values: Vec<f64> = v.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
+    let array = PyArray1::from_vec(py, values).reshape([v.len(), 3])?;
+    read_only(array.as_any())?;
+    Ok(array)
+}
+
+/// A whole number `value` given as argument `name`, from `min` to `max`: one outside is a
+/// `HookeError` that says what was expected, as any bad value is (a negative count would
+/// otherwise be Python's bare `OverflowError`).
+fn whole(value: i64, name: &str, min: u64, max: u64) -> PyResult<u64> {
+    match u64::try_from(value) {
+        Ok(n) if (min..=max).contains(&n) => Ok(n),
+        _ => Err(HookeError::new_err(format!(
+            "{name}: expected a whole number from {min} to {max}, found {value}"
+        ))),
     }
 }
 
@@ -140,91 +202,94 @@ impl Simulation {
     /// Advances `n` steps (default 1). Raises `DivergenceError` when the state stops making
     /// sense, and `KeyboardInterrupt` on Ctrl-C (after a whole step).
     #[pyo3(signature = (n = 1))]
-    fn step(&mut self, py: Python<'_>, n: u64) -> PyResult<()> {
-        self.run_steps(py, n)
+    fn step(&self, py: Python<'_>, n: i64) -> PyResult<()> {
+        let n = whole(n, "step", 0, driver::MAX_STILL_STEPS as u64)?;
+        self.lock()?.run_steps(py, n)
     }
 
     /// Advances by `seconds` of simulated time: the whole number of steps nearest to
     /// `seconds / dt`.
-    fn advance(&mut self, py: Python<'_>, seconds: f64) -> PyResult<()> {
+    fn advance(&self, py: Python<'_>, seconds: f64) -> PyResult<()> {
+        let mut inner = self.lock()?;
         if !(seconds.is_finite() && seconds >= 0.0) {
             return Err(PyValueError::new_err(format!(
                 "advance: expected a time in seconds >= 0, found {seconds}"
             )));
         }
-        let steps = driver::steps_for(&self.scene, seconds);
+        let steps = driver::steps_for(&inner.scene, seconds);
         if steps as f64 > driver::MAX_STILL_STEPS {
             return Err(PyValueError::new_err(format!(
                 "advance: {seconds} s is {steps:.1e} steps of dt = {} s, more than the {:.0e} a \
                  call may take",
-                self.scene.simulation.dt(),
+                inner.scene.simulation.dt(),
                 driver::MAX_STILL_STEPS
             )));
         }
-        self.run_steps(py, steps)
+        inner.run_steps(py, steps)
     }
 
     /// Runs to the end of the scene's run (its `duration` or `steps`), if not there yet.
-    fn run(&mut self, py: Python<'_>) -> PyResult<()> {
-        let left = self
+    fn run(&self, py: Python<'_>) -> PyResult<()> {
+        let mut inner = self.lock()?;
+        let left = inner
             .scene
             .steps
-            .saturating_sub(self.scene.simulation.steps());
-        self.run_steps(py, left)
+            .saturating_sub(inner.scene.simulation.steps());
+        inner.run_steps(py, left)
     }
 
     /// Simulated time in seconds.
     #[getter]
-    fn time(&self) -> f64 {
-        self.scene.simulation.time()
+    fn time(&self) -> PyResult<f64> {
+        Ok(self.lock()?.scene.simulation.time())
     }
 
     /// Steps taken so far.
     #[getter]
-    fn steps_taken(&self) -> u64 {
-        self.scene.simulation.steps()
+    fn steps_taken(&self) -> PyResult<u64> {
+        Ok(self.lock()?.scene.simulation.steps())
     }
 
     /// The step size in seconds.
     #[getter]
-    fn dt(&self) -> f64 {
-        self.scene.simulation.dt()
+    fn dt(&self) -> PyResult<f64> {
+        Ok(self.lock()?.scene.simulation.dt())
     }
 
     /// The integrator's name.
     #[getter]
-    fn integrator(&self) -> &'static str {
-        self.scene.simulation.integrator().name()
+    fn integrator(&self) -> PyResult<&'static str> {
+        Ok(self.lock()?.scene.simulation.integrator().name())
     }
 
     /// Steps in the scene's whole run.
     #[getter]
-    fn total_steps(&self) -> u64 {
-        self.scene.steps
+    fn total_steps(&self) -> PyResult<u64> {
+        Ok(self.lock()?.scene.steps)
     }
 
     /// A frame every this many steps, as the command writes them.
     #[getter]
-    fn every(&self) -> u64 {
-        self.scene.every
+    fn every(&self) -> PyResult<u64> {
+        Ok(self.lock()?.scene.every)
     }
 
     /// Positions in metres, an `(N, 3)` float64 array: a read-only copy of the state now.
     #[getter]
     fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        Self::matrix(py, &self.scene.simulation.particles().x)
+        matrix(py, &self.lock()?.scene.simulation.particles().x)
     }
 
     /// Velocities in m/s, an `(N, 3)` float64 array: a read-only copy of the state now.
     #[getter]
     fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        Self::matrix(py, &self.scene.simulation.particles().v)
+        matrix(py, &self.lock()?.scene.simulation.particles().v)
     }
 
     /// Masses in kg, an `(N,)` float64 array (read-only).
     #[getter]
     fn masses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let array = PyArray1::from_slice(py, &self.scene.simulation.particles().mass);
+        let array = PyArray1::from_slice(py, &self.lock()?.scene.simulation.particles().mass);
         read_only(array.as_any())?;
         Ok(array)
     }
@@ -232,7 +297,8 @@ impl Simulation {
     /// Which particles are pinned, an `(N,)` bool array (read-only).
     #[getter]
     fn pinned<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<bool>>> {
-        let p = self.scene.simulation.particles();
+        let inner = self.lock()?;
+        let p = inner.scene.simulation.particles();
         let pinned: Vec<bool> = (0..p.len()).map(|i| p.is_pinned(i)).collect();
         let array = PyArray1::from_vec(py, pinned);
         read_only(array.as_any())?;
@@ -242,7 +308,8 @@ impl Simulation {
     /// The springs' end particles, an `(M, 2)` int64 array (read-only), in the model's order.
     #[getter]
     fn springs<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
-        let springs = &self.scene.simulation.model().springs;
+        let inner = self.lock()?;
+        let springs = &inner.scene.simulation.model().springs;
         let ends: Vec<i64> = springs
             .iter()
             .flat_map(|s| [i64::from(s.i), i64::from(s.j)])
@@ -254,18 +321,20 @@ impl Simulation {
 
     /// The bodies: a list of `(name, first particle, particle count)`.
     #[getter]
-    fn bodies(&self) -> Vec<(String, usize, usize)> {
-        self.scene
+    fn bodies(&self) -> PyResult<Vec<(String, usize, usize)>> {
+        Ok(self
+            .lock()?
+            .scene
             .bodies
             .iter()
             .map(|b| (b.name.clone(), b.range.start, b.range.len()))
-            .collect()
+            .collect())
     }
 
     /// The scene's name.
     #[getter]
-    fn name(&self) -> String {
-        self.scene.spec.name.clone()
+    fn name(&self) -> PyResult<String> {
+        Ok(self.lock()?.scene.spec.name.clone())
     }
 
     /// The scene as it stands now drawn by Hooke's rasterizer: an `(height, width, 3)`
@@ -277,17 +346,21 @@ impl Simulation {
     fn render<'py>(
         &self,
         py: Python<'py>,
-        width: u32,
-        height: u32,
+        width: i64,
+        height: i64,
         style: &str,
         yaw: f64,
         pitch: f64,
         zoom: f64,
-        supersample: u32,
+        supersample: i64,
     ) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
+        let supersample = whole(supersample, "supersample", 1, 4)? as u32;
+        let width = whole(width, "width", 1, u64::from(u32::MAX))? as u32;
+        let height = whole(height, "height", 1, u64::from(u32::MAX))? as u32;
         let view = View::checked((width, height), style, (yaw, pitch), zoom, supersample)
             .map_err(error)?;
-        let (scene, pool) = (&self.scene, self.pool.as_ref());
+        let inner = self.lock()?;
+        let (scene, pool) = (&inner.scene, inner.pool.as_ref());
         let rgb = py.detach(|| {
             Self::on_pool(pool, || {
                 let image = view.pixels(scene, &view.camera(scene));
@@ -307,7 +380,7 @@ impl Simulation {
     /// state now.
     #[pyo3(signature = (path, format = None, body = None))]
     fn export(
-        &mut self,
+        &self,
         py: Python<'_>,
         path: &str,
         format: Option<&str>,
@@ -324,32 +397,39 @@ impl Simulation {
             }
         };
         let target = Target::new(Path::new(path), format, body).map_err(error)?;
-        let mut exporter = Exporter::create(&target, &self.scene).map_err(error)?;
-        let left = self
+        let mut inner = self.lock()?;
+        let mut exporter = Exporter::create(&target, &inner.scene).map_err(error)?;
+        let left = inner
             .scene
             .steps
-            .saturating_sub(self.scene.simulation.steps());
-        let every = self.scene.every;
-        exporter.frame(0, &self.scene).map_err(error)?;
+            .saturating_sub(inner.scene.simulation.steps());
+        let every = inner.scene.every;
+        exporter.frame(0, &inner.scene).map_err(error)?;
         let mut frame = 0;
         let mut stepped = 0;
         while stepped < left {
             let n = every.min(left - stepped);
-            self.run_steps(py, n)?;
+            inner.run_steps(py, n)?;
             stepped += n;
             if n == every {
                 frame += 1;
-                exporter.frame(frame, &self.scene).map_err(error)?;
+                exporter.frame(frame, &inner.scene).map_err(error)?;
             }
         }
         exporter.finish().map_err(error)
     }
 
     fn __repr__(&self) -> String {
-        let sim = &self.scene.simulation;
+        let Ok(inner) = self.lock() else {
+            return format!(
+                "<hooke.Simulation from {:?}: in use by another thread>",
+                self.source
+            );
+        };
+        let sim = &inner.scene.simulation;
         format!(
             "<hooke.Simulation '{}' from {:?}: {} particles, {} springs, {} dt = {} s, t = {} s>",
-            self.scene.spec.name,
+            inner.scene.spec.name,
             self.source,
             sim.particles().len(),
             sim.model().springs.len(),
@@ -397,11 +477,11 @@ fn load(
     source: &str,
     dt: Option<f64>,
     integrator: Option<&str>,
-    steps: Option<u64>,
+    steps: Option<i64>,
     duration: Option<f64>,
-    every: Option<u64>,
+    every: Option<i64>,
     table: Option<&str>,
-    threads: Option<usize>,
+    threads: Option<i64>,
     set: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Simulation> {
     let integrator = integrator
@@ -414,9 +494,12 @@ fn load(
         ))),
         _ => Ok(x),
     };
-    if steps == Some(0) || every == Some(0) {
-        return Err(HookeError::new_err("steps and every: expected at least 1"));
-    }
+    let steps = steps
+        .map(|n| whole(n, "steps", 1, hooke_scene::MAX_STEPS))
+        .transpose()?;
+    let every = every
+        .map(|n| whole(n, "every", 1, hooke_scene::MAX_STEPS))
+        .transpose()?;
     let table = table.map(source::table).transpose().map_err(error)?;
     let overrides = Overrides {
         integrator,
@@ -435,24 +518,24 @@ fn load(
                 .map_err(|e| error(anyhow::Error::new(e).context(format!("scene '{source}'"))))?;
         }
     }
+    let threads = threads
+        .map(|t| whole(t, "threads", 0, u64::MAX).map(|n| n as usize))
+        .transpose()?;
     let pool = match threads {
-        None => None,
-        Some(0) => return Err(HookeError::new_err("threads: expected at least 1")),
-        Some(n) => Some(
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|e| HookeError::new_err(format!("threads: {e}")))?,
-        ),
+        None => {
+            // rayon's global pool reads RAYON_NUM_THREADS: bounded like `threads`.
+            hooke_cli::threads::from_environment().map_err(error)?;
+            None
+        }
+        Some(n) => Some(hooke_cli::threads::pool(Some(n), "threads").map_err(error)?),
     };
     let scene = Simulation::on_pool(pool.as_ref(), || {
         source::build_from(read, source, &overrides)
     })
     .map_err(error)?;
     Ok(Simulation {
-        scene,
+        inner: Mutex::new(Inner { scene, pool }),
         source: source.to_string(),
-        pool,
     })
 }
 

@@ -253,14 +253,7 @@ struct RenderFigures {
 }
 
 fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(t) = threads {
-        if t == 0 {
-            bail!("--threads: expected at least 1");
-        }
-        builder = builder.num_threads(t);
-    }
-    builder.build().context("cannot start the worker threads")
+    hooke_cli::threads::pool(threads, "--threads")
 }
 
 fn workload(n: usize, steps: u64, integrator: Integrator, air: bool) -> Result<Scene> {

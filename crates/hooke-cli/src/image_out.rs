@@ -2,7 +2,7 @@
 //! frame by frame as a run produces them, so its memory does not grow with its length.
 
 use crate::draw::{DEFAULT_YAW_PITCH, Style, draw, frame_camera};
-use crate::output::{AtomicFile, write_atomic};
+use crate::output::{OutputFile, write_atomic};
 use anyhow::{Context, Result};
 use hooke_render::{Camera, RenderOptions, render};
 use hooke_scene::Scene;
@@ -202,7 +202,7 @@ pub fn write_png(path: &Path, image: &RgbaImage) -> Result<()> {
 /// [`GifWriter::finish`], and a writer dropped unfinished leaves nothing behind.
 pub struct GifWriter {
     path: PathBuf,
-    encoder: gif::Encoder<AtomicFile>,
+    encoder: gif::Encoder<OutputFile>,
     size: (u16, u16),
     /// Frame delay, hundredths of a second (GIF's unit).
     delay: u16,
@@ -216,7 +216,7 @@ impl GifWriter {
         let cannot = || format!("cannot write {}", path.display());
         let w = u16::try_from(size.0).with_context(cannot)?;
         let h = u16::try_from(size.1).with_context(cannot)?;
-        let file = AtomicFile::create(path)?;
+        let file = OutputFile::create(path)?;
         let mut encoder = gif::Encoder::new(file, w, h, &[]).with_context(cannot)?;
         encoder
             .set_repeat(gif::Repeat::Infinite)

@@ -13,3 +13,4 @@ pub mod memory;
 pub mod output;
 pub mod source;
 pub mod stills;
+pub mod threads;

@@ -16,7 +16,8 @@ use hooke_scene::Overrides;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-/// Mass-spring simulation you can trust: five course scenes, jello worlds, your own scene files.
+/// Mass-spring simulation you can trust: seven built-in scenes (the course's five among them),
+/// jello worlds, your own scene files.
 #[derive(Parser)]
 #[command(name = "hooke", version, about)]
 struct Cli {
@@ -30,7 +31,7 @@ enum Command {
     Run(RunArgs),
     /// Render a still of a scene at a given time to PNG.
     Render(RenderArgs),
-    /// The main job: simulate the five built-in scenes and write a still of each plus an
+    /// The main job: simulate the seven built-in scenes and write a still of each plus an
     /// animation.
     Demo {
         /// Output folder.
@@ -205,9 +206,12 @@ fn main() -> ExitCode {
     // waiting inside another would spin on a core the measured one needs).
     let result = match cli.command {
         Command::View(_) | Command::Bench(_) => dispatch(cli.command),
-        command => match rayon::ThreadPoolBuilder::new().build() {
-            Ok(pool) => pool.install(|| dispatch(command)),
-            Err(_) => dispatch(command),
+        command => match hooke_cli::threads::from_environment() {
+            Err(e) => Err(e),
+            Ok(_) => match hooke_cli::threads::pool(None, "--threads") {
+                Ok(pool) => pool.install(|| dispatch(command)),
+                Err(_) => dispatch(command),
+            },
         },
     };
     match result {

@@ -20,7 +20,18 @@ const ANNOUNCE_STEPS: u64 = 1_000_000;
 
 pub fn render(args: &RenderArgs) -> Result<ExitCode> {
     check_output_file(&args.output, "-o", &["png"])?;
-    let mut scene = source::build(&args.scene, &args.setup.overrides()?)?;
+    let source = source::prepare(
+        source::read(&args.scene)?,
+        &args.scene,
+        &args.setup.overrides()?,
+    )?;
+    let mut claims = hooke_cli::output::claims::Claims::default();
+    for (what, path) in source.inputs() {
+        claims.input(what, &path);
+    }
+    claims.file("-o", &args.output);
+    claims.check()?;
+    let mut scene = source::build_prepared(source, &args.scene)?;
     let dt = scene.simulation.dt();
     let steps = steps_to(&scene, args.at)?;
     if steps >= ANNOUNCE_STEPS {
@@ -50,6 +61,8 @@ pub fn demo(out: &Path, view: &View) -> Result<ExitCode> {
     check_output_folder(out, "--out")?;
     std::fs::create_dir_all(out)
         .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
+    // Two demos writing one folder would mix their stills.
+    let _held = hooke_cli::output::lock::FolderLock::take(out, "--out")?;
     let mut written: Vec<PathBuf> = Vec::new();
     for (k, (name, _)) in BUILTINS.iter().enumerate() {
         let started = Instant::now();
@@ -110,6 +123,8 @@ fn animate(
 /// Writes frames of a run as numbered PNGs and optionally a GIF, each as it comes.
 pub struct FrameSink {
     dir: Option<PathBuf>,
+    /// The frame folder, held for this run.
+    _lock: Option<hooke_cli::output::lock::FolderLock>,
     gif: Option<GifWriter>,
     view: View,
     camera: Option<hooke_render::Camera>,
@@ -128,8 +143,10 @@ impl FrameSink {
         if dir.is_none() && gif.is_none() {
             return Ok(None);
         }
+        let mut lock = None;
         if let Some(d) = &dir {
-            let removed = prepare_frame_folder(d, "--frames", "png")?;
+            let (held, removed) = prepare_frame_folder(d, "--frames", "png")?;
+            lock = Some(held);
             if removed > 0 {
                 eprintln!(
                     "--frames: removed {removed} frame{} of an earlier run from {}",
@@ -147,6 +164,7 @@ impl FrameSink {
         };
         Ok(Some(Self {
             dir,
+            _lock: lock,
             gif,
             view,
             camera: None,

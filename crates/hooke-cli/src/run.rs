@@ -7,6 +7,7 @@ use anyhow::{Context, Result, bail};
 use hooke_cli::driver::drive;
 use hooke_cli::export::{Exporter, Target};
 use hooke_cli::interrupt::{self, is_interrupt};
+use hooke_cli::output::claims::Claims;
 use hooke_cli::output::{check_output_file, check_output_folder};
 use hooke_core::Num;
 use hooke_core::{Divergence, Integrator, StabilityEstimate, Summary};
@@ -174,7 +175,29 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         every: args.every,
         ..args.setup.overrides()?
     };
-    let mut scene = source::build(&args.scene, &overrides)?;
+    let source = source::prepare(source::read(&args.scene)?, &args.scene, &overrides)?;
+    // No output may replace an input or another output.
+    let mut claims = Claims::default();
+    for (what, path) in source.inputs() {
+        claims.input(what, &path);
+    }
+    if let Some(path) = &args.trajectory {
+        claims.file("--trajectory", path);
+    }
+    if let Some(path) = &args.gif {
+        claims.file("--gif", path);
+    }
+    if let Some(dir) = &args.frames {
+        claims.frames("--frames", dir, "png");
+    }
+    if let Some(target) = &export_target {
+        target.claim(&mut claims);
+    }
+    if args.summary {
+        claims.file("--summary", Path::new("-"));
+    }
+    claims.check()?;
+    let mut scene = source::build_prepared(source, &args.scene)?;
     warn_if_unstable(&scene);
     warn_if_tunnelling(&scene);
     let mut trajectory = args
@@ -341,6 +364,10 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
 
 pub fn convert(input: &Path, output: &Path) -> Result<ExitCode> {
     check_output_file(output, "convert", &["toml", "w"])?;
+    let mut claims = Claims::default();
+    claims.input("the file converted", input);
+    claims.file("convert", output);
+    claims.check()?;
     let ext = |p: &Path| {
         p.extension()
             .and_then(|e| e.to_str())

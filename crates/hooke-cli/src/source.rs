@@ -13,6 +13,27 @@ pub struct Source {
     pub spec: SceneSpec,
     /// Folder that relative paths inside it are resolved against.
     pub base: PathBuf,
+    /// The scene file or world it was read from; `None` for a built-in.
+    pub file: Option<PathBuf>,
+}
+
+impl Source {
+    /// The files the scene is built from, each with what to call it in a message: the scene
+    /// file or world, and the mesh files it names (after any `--table`).
+    pub fn inputs(&self) -> Vec<(String, PathBuf)> {
+        let mut files: Vec<(String, PathBuf)> = self
+            .file
+            .iter()
+            .map(|f| ("the scene file".to_string(), f.clone()))
+            .collect();
+        files.extend(
+            self.spec
+                .input_files(&self.base)
+                .into_iter()
+                .map(|(key, path)| (format!("the mesh of {key}"), path)),
+        );
+        files
+    }
 }
 
 /// Reads the scene named by `arg`.
@@ -34,6 +55,7 @@ pub fn read(arg: &str) -> Result<Source> {
         return Ok(Source {
             spec,
             base: PathBuf::from("."),
+            file: None,
         });
     }
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
@@ -52,7 +74,11 @@ pub fn read(arg: &str) -> Result<Source> {
             path.display()
         ),
     };
-    Ok(Source { spec, base })
+    Ok(Source {
+        spec,
+        base,
+        file: Some(path.to_path_buf()),
+    })
 }
 
 fn stem(path: &Path) -> String {
@@ -71,6 +97,11 @@ pub fn table(value: &str) -> Result<TableOverride> {
         return Ok(TableOverride::Mesh(value.to_string()));
     }
     let path = Path::new(value);
+    if path.is_dir() {
+        bail!(
+            "--table {value}: is a folder; expected an OBJ mesh file, builtin:NAME or `cylinder`"
+        );
+    }
     if !path.is_file() {
         bail!("--table {value}: no such file (expected an OBJ mesh, builtin:NAME or `cylinder`)");
     }
@@ -88,7 +119,13 @@ pub fn build(arg: &str, overrides: &Overrides) -> Result<Scene> {
 }
 
 /// [`build`] for a scene already read (and perhaps edited) from `arg`.
-pub fn build_from(mut source: Source, arg: &str, overrides: &Overrides) -> Result<Scene> {
+pub fn build_from(source: Source, arg: &str, overrides: &Overrides) -> Result<Scene> {
+    build_prepared(prepare(source, arg, overrides)?, arg)
+}
+
+/// A scene read from `arg` with the command line's overrides applied: what
+/// [`build_prepared`] builds, and whose [`Source::inputs`] a run checks its outputs against.
+pub fn prepare(mut source: Source, arg: &str, overrides: &Overrides) -> Result<Source> {
     // The overrides come from the command line: name its options, not the scene's keys.
     overrides.apply(&mut source.spec).map_err(|e| {
         let e = match e {
@@ -105,6 +142,12 @@ pub fn build_from(mut source: Source, arg: &str, overrides: &Overrides) -> Resul
         };
         anyhow::Error::new(e).context(format!("scene '{arg}'"))
     })?;
+    Ok(source)
+}
+
+/// Builds a scene [`prepare`]d from `arg`. A scene whose estimated memory exceeds the budget
+/// ([`crate::memory`]) is refused before it is built.
+pub fn build_prepared(source: Source, arg: &str) -> Result<Scene> {
     let footprint = source.spec.footprint(&source.base);
     crate::memory::check(arg, &footprint)?;
     let large = footprint.bytes() >= ANNOUNCE_BYTES;

@@ -1,7 +1,7 @@
 //! Trajectory CSV (docs/physics.md §6): `frame,time,particle,x,y,z,vx,vy,vz`, numbers in
 //! their shortest round-trip form ([`hooke_core::Num`]: scientific far from 1).
 
-use crate::output::AtomicFile;
+use crate::output::OutputFile;
 use anyhow::{Context, Result};
 use hooke_core::{Num, Particles};
 use std::io::Write;
@@ -12,14 +12,14 @@ pub const HEADER: &str = "frame,time,particle,x,y,z,vx,vy,vz";
 
 /// A trajectory file being written frame by frame.
 pub struct TrajectoryWriter {
-    file: AtomicFile,
+    file: OutputFile,
     path: PathBuf,
 }
 
 impl TrajectoryWriter {
     /// Starts a trajectory file (in place only when finished).
     pub fn create(path: &Path) -> Result<Self> {
-        let mut file = AtomicFile::create(path)?;
+        let mut file = OutputFile::create(path)?;
         writeln!(file.writer(), "{HEADER}")
             .with_context(|| format!("cannot write {}", path.display()))?;
         Ok(Self {

@@ -350,9 +350,7 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
     window.set_target_fps(0);
     let mut viewer = Viewer::new(scenes)?;
     let mut renderer = Renderer::default();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .build()
-        .context("cannot start the worker threads")?;
+    let pool = hooke_cli::threads::pool(None, "--threads")?;
     let mut buffer = vec![0u32; w * h];
     let options = viewer.options(size, args.supersample);
 

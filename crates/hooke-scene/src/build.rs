@@ -585,6 +585,24 @@ fn pairs(
         .collect()
 }
 
+impl SceneSpec {
+    /// The files building the scene reads, each with the key that names it
+    /// (`collider[2].shape.path`): its mesh files, resolved against `base` (built-in meshes
+    /// are no files). For checking, before a run, that no output replaces one.
+    pub fn input_files(&self, base: &Path) -> Vec<(String, PathBuf)> {
+        self.colliders
+            .iter()
+            .enumerate()
+            .filter_map(|(c, collider)| match &collider.shape {
+                ColliderShapeSpec::Mesh { path, .. } if !path.starts_with("builtin:") => {
+                    Some((format!("collider[{c}].shape.path"), base.join(path)))
+                }
+                _ => None,
+            })
+            .collect()
+    }
+}
+
 /// The size in bytes of the mesh a path names (0 when it cannot be found: the build says why).
 pub(crate) fn mesh_file_len(path: &str, base: &Path) -> u64 {
     match path.strip_prefix("builtin:") {

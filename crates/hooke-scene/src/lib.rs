@@ -4,7 +4,7 @@
 //!   [`load_scene`], written by [`to_toml`];
 //! * generators for chains, cloth grids and jelly lattices with structural, shear and bend
 //!   springs ([`generators`]);
-//! * the five built-in scenes ([`builtin`]);
+//! * the seven built-in scenes ([`builtin`]): the course's five, `cloth-pile` and `flag`;
 //! * building a ready-to-step [`Scene`] from a description ([`SceneSpec::build`]).
 //!
 //! ```

@@ -113,6 +113,13 @@ impl Target {
             }
             (false, "pc2", None) => {
                 check_output_file(path, "--export", &["pc2"])?;
+                if crate::output::destination::destination(path, "--export")?.is_stream() {
+                    bail!(
+                        "--export {}: a point cache is written with its sample count at the \
+                         start, known only at the end: it needs a regular file, not a stream",
+                        path.display()
+                    );
+                }
                 check_output_file(&path.with_extension("obj"), "--export (its mesh)", &["obj"])?;
                 Target::Pc2 {
                     path: path.to_path_buf(),
@@ -129,6 +136,20 @@ impl Target {
             bail!("--body: only a .pc2 export holds one body; the others hold them all");
         }
         Ok(target)
+    }
+}
+
+impl Target {
+    /// Adds the files and folders this export writes to `claims`.
+    pub fn claim(&self, claims: &mut crate::output::claims::Claims) {
+        match self {
+            Target::Usd(path) => claims.file("--export", path),
+            Target::Pc2 { path, .. } => {
+                claims.file("--export", path);
+                claims.file("--export (its mesh)", &path.with_extension("obj"));
+            }
+            Target::Folder { dir, format } => claims.frames("--export", dir, format.extension()),
+        }
     }
 }
 
@@ -186,9 +207,9 @@ impl Exporter {
 
 /// Prepares `dir` for a folder export's `frame-NNNNN.ext` files (see
 /// [`crate::output::prepare_frame_folder`]), saying how many frames of an earlier run it
-/// removed.
-fn frame_folder(dir: &Path, ext: &str) -> Result<()> {
-    let removed = crate::output::prepare_frame_folder(dir, "--export", ext)?;
+/// removed; returns the folder's lock.
+fn frame_folder(dir: &Path, ext: &str) -> Result<crate::output::lock::FolderLock> {
+    let (lock, removed) = crate::output::prepare_frame_folder(dir, "--export", ext)?;
     if removed > 0 {
         eprintln!(
             "--export: removed {removed} frame{} of an earlier run from {}",
@@ -196,7 +217,7 @@ fn frame_folder(dir: &Path, ext: &str) -> Result<()> {
             dir.display()
         );
     }
-    Ok(())
+    Ok(lock)
 }
 
 /// What a body becomes outside Hooke.

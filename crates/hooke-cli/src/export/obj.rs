@@ -8,7 +8,7 @@
 //! [`super::collider_triangles`]). Numbers are Rust's shortest round-trip numbers
 //! ([`hooke_core::Num`]); every file is written whole or not at all.
 
-use crate::output::AtomicFile;
+use crate::output::OutputFile;
 use anyhow::{Context, Result};
 use hooke_core::{Num, Spring, Vec3};
 use hooke_scene::{Body, Scene};
@@ -19,6 +19,8 @@ use std::path::{Path, PathBuf};
 #[derive(Debug)]
 pub struct ObjExport {
     dir: PathBuf,
+    /// The folder, held for this run.
+    _lock: crate::output::lock::FolderLock,
     /// Frames written.
     frames: u64,
     /// `collider:<index>-<kind>` and its triangles, which do not move.
@@ -29,13 +31,14 @@ impl ObjExport {
     /// Prepares the folder `dir` (created if missing; refused if it is a file) for `scene`,
     /// whose collider surfaces are computed here once.
     pub fn new(dir: &Path, scene: &Scene) -> Result<Self> {
-        super::frame_folder(dir, "obj")?;
+        let lock = super::frame_folder(dir, "obj")?;
         let colliders = super::collider_triangles(scene)
             .into_iter()
             .map(|(name, triangles)| (format!("collider:{name}"), triangles))
             .collect();
         Ok(Self {
             dir: dir.to_path_buf(),
+            _lock: lock,
             frames: 0,
             colliders,
         })
@@ -59,7 +62,7 @@ impl ObjExport {
     /// Writes frame `frame` of `scene` at its current state.
     pub fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
         let path = self.path(frame);
-        let mut file = AtomicFile::create(&path)?;
+        let mut file = OutputFile::create(&path)?;
         write_frame(file.writer(), frame, scene, &self.colliders)
             .with_context(|| format!("cannot write {}", path.display()))?;
         file.commit()?;

@@ -15,7 +15,7 @@
 //! Samples are appended as the run goes; the count in the header is written when the run
 //! ends, at the last complete frame.
 
-use crate::output::AtomicFile;
+use crate::output::OutputFile;
 use anyhow::{Context, Result, bail};
 use hooke_scene::{Body, Scene};
 use std::io::{Seek, SeekFrom, Write};
@@ -32,7 +32,7 @@ pub const HEADER_BYTES: u64 = 32;
 /// A point cache being written.
 pub struct Pc2Export {
     path: PathBuf,
-    file: AtomicFile,
+    file: OutputFile,
     body: String,
     range: Range<usize>,
     samples: u32,
@@ -69,7 +69,7 @@ impl Pc2Export {
             .filter(|&n| n <= i32::MAX as u32)
             .with_context(|| format!("--export: body {} is too large for a PC2", body.name))?;
         let mesh = path.with_extension("obj");
-        let mut obj = AtomicFile::create(&mesh)?;
+        let mut obj = OutputFile::create(&mesh)?;
         let sim = &scene.simulation;
         let x = &sim.particles().x;
         let springs = &sim.model().springs;
@@ -86,7 +86,7 @@ impl Pc2Export {
         })()
         .with_context(|| format!("cannot write {}", mesh.display()))?;
         obj.commit()?;
-        let mut file = AtomicFile::create(path)?;
+        let mut file = OutputFile::create(path)?;
         let w = file.writer();
         let header = (|| -> std::io::Result<()> {
             w.write_all(MAGIC)?;

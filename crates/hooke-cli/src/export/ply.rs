@@ -7,7 +7,7 @@
 //! triangles as `vertex_indices`. Colliders do not move and are left out (`--format obj`
 //! has them). Values are `float`, as renderers read them.
 
-use crate::output::AtomicFile;
+use crate::output::OutputFile;
 use anyhow::{Context, Result};
 use hooke_core::{Num, Vec3};
 use hooke_scene::Scene;
@@ -84,6 +84,8 @@ impl PropertyAccess for PlyFace {
 /// Writes a scene's frames as PLY files into one folder.
 pub struct PlyExport {
     dir: PathBuf,
+    /// The folder, held for this run.
+    _lock: crate::output::lock::FolderLock,
     /// The triangles of every body, as particle indices.
     faces: Vec<PlyFace>,
     triangles: Vec<[u32; 3]>,
@@ -97,7 +99,7 @@ impl PlyExport {
     /// Prepares the folder `dir` (created if missing; refused if it is a file, cleared of
     /// an earlier run's frames) for `scene`.
     pub fn new(dir: &Path, scene: &Scene) -> Result<Self> {
-        super::frame_folder(dir, "ply")?;
+        let lock = super::frame_folder(dir, "ply")?;
         let triangles: Vec<[u32; 3]> = scene
             .bodies
             .iter()
@@ -111,6 +113,7 @@ impl PlyExport {
             .collect();
         Ok(Self {
             dir: dir.to_path_buf(),
+            _lock: lock,
             faces,
             triangles,
             normals: Vec::new(),
@@ -135,7 +138,7 @@ impl PlyExport {
                 n: super::f32s(n),
             }));
         let path = self.path(frame);
-        let mut file = AtomicFile::create(&path)?;
+        let mut file = OutputFile::create(&path)?;
         self.write(file.writer(), frame, scene)
             .with_context(|| format!("cannot write {}", path.display()))?;
         file.commit()?;

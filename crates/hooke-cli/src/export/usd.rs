@@ -22,7 +22,7 @@
 //! block, when it ends. Memory stays flat however long the run.
 
 use super::{Shape, shape};
-use crate::output::AtomicFile;
+use crate::output::OutputFile;
 use anyhow::{Context, Result};
 use hooke_core::{Num, Vec3};
 use hooke_scene::Scene;
@@ -84,9 +84,9 @@ struct BodyStream {
     /// The prim's opening and its static attributes (topology, widths, colour).
     opening: String,
     /// Scratch files of the `points`, `velocities` and `extent` samples.
-    points: AtomicFile,
-    velocities: AtomicFile,
-    extent: AtomicFile,
+    points: OutputFile,
+    velocities: OutputFile,
+    extent: OutputFile,
 }
 
 /// A USD stage being written.
@@ -113,8 +113,9 @@ impl UsdExport {
                 prim = format!("{prim}_{k}");
             }
             taken.push(prim.clone());
-            let scratch =
-                |what: &str| AtomicFile::create(&path.with_extension(format!("usda.{k}.{what}")));
+            // Hidden temporary files beside the stage (or in the system's temporary folder
+            // for a stream), so that no file of another name is written beside it.
+            let scratch = |_: &str| OutputFile::scratch(path);
             bodies.push(BodyStream {
                 opening: opening(&prim, body)?,
                 points: scratch("points")?,
@@ -137,7 +138,7 @@ impl UsdExport {
         let p = scene.simulation.particles();
         for (body, stream) in scene.bodies.iter().zip(&mut self.bodies) {
             let r = body.range.clone();
-            let write = |file: &mut AtomicFile, values: &mut dyn Iterator<Item = [f32; 3]>| {
+            let write = |file: &mut OutputFile, values: &mut dyn Iterator<Item = [f32; 3]>| {
                 let w = file.writer();
                 write!(w, "            {frame}: [")?;
                 for (k, v) in values.enumerate() {
@@ -176,7 +177,7 @@ impl UsdExport {
 
     /// Assembles the stage from the samples written so far and puts it in place.
     pub fn finish(mut self) -> Result<String> {
-        let mut file = AtomicFile::create(&self.path)?;
+        let mut file = OutputFile::create(&self.path)?;
         self.assemble(&mut file)
             .with_context(|| format!("cannot write {}", self.path.display()))?;
         file.commit()?;
@@ -189,7 +190,7 @@ impl UsdExport {
         ))
     }
 
-    fn assemble(&mut self, file: &mut AtomicFile) -> Result<()> {
+    fn assemble(&mut self, file: &mut OutputFile) -> Result<()> {
         let fps = Num(1.0 / self.frame_time);
         let w = file.writer();
         writeln!(w, "#usda 1.0\n(")?;

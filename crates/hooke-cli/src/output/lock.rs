@@ -1,0 +1,124 @@
+//! A folder of frames held by one run at a time: `DIR/.hooke-lock`, locked with the
+//! system's advisory file lock (`flock`), which the system releases when the holder exits,
+//! however it exits. The file names the holder (process id and command) for the message a
+//! second run gets.
+
+use anyhow::{Context, Result, bail};
+use std::fs::{File, OpenOptions, TryLockError};
+use std::io::{Read, Seek, SeekFrom, Write};
+use std::os::unix::fs::MetadataExt;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, Weak};
+
+/// The lock file's name inside a held folder.
+pub const LOCK_NAME: &str = ".hooke-lock";
+
+/// A held folder; when the last handle is dropped the folder is released and the lock file
+/// removed. One process takes a folder once: a second writer of the same run (frames and a
+/// folder export into one folder) shares the handle.
+#[derive(Clone, Debug)]
+pub struct FolderLock(#[allow(dead_code)] Arc<Held>);
+
+#[derive(Debug)]
+struct Held {
+    path: PathBuf,
+    file: File,
+}
+
+/// A folder's device and inode.
+type FolderId = (u64, u64);
+
+/// The folders this process holds.
+static HELD: Mutex<Vec<(FolderId, Weak<Held>)>> = Mutex::new(Vec::new());
+
+/// What this process says of itself in a lock file.
+fn holder() -> String {
+    let command: Vec<String> = std::env::args().collect();
+    format!("process {} ({})", std::process::id(), command.join(" "))
+}
+
+impl FolderLock {
+    /// Takes folder `dir` (given with option `flag`) for this run, or says which process
+    /// holds it.
+    pub fn take(dir: &Path, flag: &str) -> Result<Self> {
+        let meta = std::fs::metadata(dir)
+            .with_context(|| format!("{flag} {}: cannot read the folder", dir.display()))?;
+        let key = (meta.dev(), meta.ino());
+        let mut held = HELD.lock().unwrap_or_else(|e| e.into_inner());
+        held.retain(|(_, w)| w.strong_count() > 0);
+        if let Some(h) = held
+            .iter()
+            .find(|(k, _)| *k == key)
+            .and_then(|(_, w)| w.upgrade())
+        {
+            return Ok(Self(h));
+        }
+        let h = Arc::new(Held::take(dir, flag)?);
+        held.push((key, Arc::downgrade(&h)));
+        Ok(Self(h))
+    }
+}
+
+impl Held {
+    fn take(dir: &Path, flag: &str) -> Result<Self> {
+        let path = dir.join(LOCK_NAME);
+        // A lock file another run removes between our open and our lock is no longer the
+        // folder's: try again with the new one.
+        for _ in 0..8 {
+            let mut file = OpenOptions::new()
+                .read(true)
+                .write(true)
+                .create(true)
+                .truncate(false)
+                .open(&path)
+                .with_context(|| format!("{flag} {}: cannot create {LOCK_NAME}", dir.display()))?;
+            match file.try_lock() {
+                Ok(()) => {}
+                Err(TryLockError::WouldBlock) => {
+                    let mut said = String::new();
+                    let _ = file.read_to_string(&mut said);
+                    let said = said.trim();
+                    bail!(
+                        "{flag} {}: the folder is being written by another run, {}; wait for it \
+                         to end or choose another folder",
+                        dir.display(),
+                        if said.is_empty() {
+                            "which has not said who it is"
+                        } else {
+                            said
+                        }
+                    );
+                }
+                Err(TryLockError::Error(e)) => {
+                    return Err(e).with_context(|| {
+                        format!("{flag} {}: cannot lock the folder", dir.display())
+                    });
+                }
+            }
+            let same = std::fs::metadata(&path)
+                .ok()
+                .zip(file.metadata().ok())
+                .is_some_and(|(a, b)| (a.dev(), a.ino()) == (b.dev(), b.ino()));
+            if !same {
+                continue;
+            }
+            file.set_len(0)?;
+            file.seek(SeekFrom::Start(0))?;
+            writeln!(file, "{}", holder())
+                .with_context(|| format!("{flag} {}: cannot write {LOCK_NAME}", dir.display()))?;
+            return Ok(Self { path, file });
+        }
+        bail!(
+            "{flag} {}: cannot lock the folder (its lock file keeps changing)",
+            dir.display()
+        )
+    }
+}
+
+impl Drop for Held {
+    fn drop(&mut self) {
+        // Removed while still locked: a run waiting on this file finds it gone and retries.
+        let _ = std::fs::remove_file(&self.path);
+        let _ = self.file.unlock();
+    }
+}
