@@ -3,8 +3,8 @@
 //!
 //! Each frame the simulation advances by the wall-clock time since the last frame (in whole
 //! steps, at most [`MAX_SIM_SHARE`] of a frame's budget, so a slow scene runs slower than
-//! real time rather than freezing the window), then the scene is drawn and the overlay
-//! written on top.
+//! real time rather than freezing the window), or by a fixed `--clock` of simulated time,
+//! then the scene is drawn and the overlay written on top.
 
 use crate::draw::{DEFAULT_YAW_PITCH, Style, draw_with, frame_camera};
 use crate::image_out::write_png;
@@ -40,6 +40,21 @@ pub struct ViewArgs {
     /// Close after this many frames and print the frame-rate figures (for measurements).
     #[arg(long)]
     frames: Option<u64>,
+    /// Advance exactly this many seconds of simulated time per frame, however long a frame
+    /// takes (default: keep pace with the wall clock). For recordings, and for tests that
+    /// must see the same motion on a loaded machine as on a quiet one.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_clock)]
+    clock: Option<f64>,
+}
+
+/// A frame's simulated time: finite, positive, at most a second.
+fn parse_clock(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 && x <= 1.0 => Ok(x),
+        _ => Err(format!(
+            "expected seconds of simulated time per frame, above 0 and at most 1, found '{s}'"
+        )),
+    }
 }
 
 const HELP: [&str; 2] = [
@@ -172,13 +187,18 @@ impl Viewer {
         self.camera.pitch = (self.camera.pitch + dy as f64 * 0.4).clamp(-89.0, 89.0);
     }
 
-    /// Advances the simulation by `wall` seconds of wall-clock time, in whole steps, within
-    /// [`MAX_SIM_SHARE`] of a frame.
-    fn simulate(&mut self, wall: f64) {
+    /// Advances the simulation by `wall` seconds, in whole steps, within [`MAX_SIM_SHARE`]
+    /// of a frame when keeping pace with the wall clock, or all of them with a fixed
+    /// `--clock` (`fixed`).
+    fn simulate(&mut self, wall: f64, fixed: bool) {
         if self.paused || self.message.is_some() {
             return;
         }
-        let budget = Duration::from_secs_f64(MAX_SIM_SHARE * FRAME);
+        let budget = if fixed {
+            Duration::MAX
+        } else {
+            Duration::from_secs_f64(MAX_SIM_SHARE * FRAME)
+        };
         match driver::catch_up(&mut self.scene, self.owed + wall, budget) {
             Ok(owed) => self.owed = owed,
             // The window loop sees the interrupt itself and closes.
@@ -362,7 +382,7 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
     let mut window_start = (Instant::now(), 0u64);
     while window.is_open() && !window.is_key_down(Key::Escape) && !interrupt::requested() {
         let now = Instant::now();
-        let wall = (now - last).as_secs_f64().min(0.25);
+        let wall = args.clock.unwrap_or((now - last).as_secs_f64().min(0.25));
         last = now;
 
         for key in window.get_keys_pressed(KeyRepeat::No) {
@@ -415,7 +435,7 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
         // The window stays on this thread; the work of a frame runs on a pool worker, where
         // the solver's and rasterizer's parallel loops are cheap joins.
         let t0 = Instant::now();
-        pool.install(|| viewer.simulate(wall));
+        pool.install(|| viewer.simulate(wall, args.clock.is_some()));
         let t1 = Instant::now();
         let pixels = pool.install(|| {
             let list = draw_with(&viewer.scene, viewer.style, |k| viewer.show(k));

@@ -264,7 +264,14 @@ fn ctrl_c_stops_a_run_at_a_complete_frame() {
         &dir,
     );
     // Let it write some frames, then interrupt.
-    std::thread::sleep(std::time::Duration::from_millis(1500));
+    wait_for("frames", || {
+        std::fs::read_dir(dir.join("frames")).is_ok_and(|d| {
+            d.flatten()
+                .filter(|e| e.path().extension().is_some_and(|x| x == "png"))
+                .count()
+                >= 2
+        })
+    });
     interrupt(&child);
     let out = child.wait_with_output().unwrap();
     assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));

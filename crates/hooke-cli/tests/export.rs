@@ -359,7 +359,16 @@ fn an_interrupted_usd_export_ends_at_a_complete_frame() {
         ],
         &dir,
     );
-    std::thread::sleep(std::time::Duration::from_millis(2500));
+    // Under way once the trajectory being written holds three frames of the 1024-particle
+    // cloth (its temporary file; about 70 bytes a row).
+    wait_for("three frames", || {
+        std::fs::read_dir(&dir).is_ok_and(|d| {
+            d.flatten().any(|e| {
+                e.file_name().to_string_lossy().ends_with(".tmp")
+                    && e.metadata().is_ok_and(|m| m.len() > 3 * 1024 * 70)
+            })
+        })
+    });
     interrupt(&child);
     let out = child.wait_with_output().unwrap();
     assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));

@@ -79,23 +79,28 @@ fn two_interrupts_keep_every_complete_frame() {
 #[test]
 fn render_and_demo_stop_on_interrupt_with_status_130() {
     let dir = scratch("render-int");
-    for (args, started) in [
+    // Each is interrupted once it is under way: the still once it has said how many steps
+    // it takes, the demo once its first still is written.
+    let still_announced = |w: &Watched| w.wait_to_say("Ctrl-C stops");
+    let demo_started = |_: &Watched| {
+        wait_for("the demo's first still", || {
+            dir.join("d/1-single-spring.png").exists()
+        })
+    };
+    let cases: [(&[&str], &dyn Fn(&Watched)); 2] = [
         (
-            &["render", "chain", "--at", "1e6", "-o", "z.png"][..],
-            700u64,
+            &["render", "chain", "--at", "1e6", "-o", "z.png"],
+            &still_announced,
         ),
-        (&["demo", "--out", "d"][..], 1500),
-    ] {
-        let child = spawn(args, &dir);
-        std::thread::sleep(Duration::from_millis(started));
-        interrupt(&child);
-        let out = child.wait_with_output().unwrap();
-        assert_eq!(out.status.code(), Some(130), "{args:?}: {}", stderr(&out));
-        assert!(
-            stderr(&out).contains("interrupted at step"),
-            "{}",
-            stderr(&out)
-        );
+        (&["demo", "--out", "d"], &demo_started),
+    ];
+    for (args, under_way) in cases {
+        let watched = Watched::spawn(args, &dir);
+        under_way(&watched);
+        interrupt(&watched.child);
+        let (status, said) = watched.finish();
+        assert_eq!(status.code(), Some(130), "{args:?}: {said}");
+        assert!(said.contains("interrupted at step"), "{said}");
     }
     assert!(!dir.join("z.png").exists());
     assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());

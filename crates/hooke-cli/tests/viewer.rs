@@ -1,6 +1,9 @@
 //! `hooke view` in a real window: an X server (Xvfb) is started, keys are sent with
 //! xdotool, and the viewer's own screenshots (SPACE) show that the picture moves over time,
-//! changes with TAB, and that W stills the flag's wind.
+//! changes with TAB, and that W stills the flag's wind. Nothing here depends on the
+//! machine's speed: the viewer runs on a fixed clock (`--clock`, simulated time per frame),
+//! keys are held until the viewer has acted on them, and the motion is awaited over a
+//! bounded number of screenshots, not seconds.
 //!
 //! Needs `Xvfb` and `xdotool` (`cargo xtask test` installs them). Without them the test
 //! fails with what to install, unless `HOOKE_SKIP_VIEWER` is set.
@@ -130,14 +133,57 @@ fn screenshots(dir: &Path) -> Vec<PathBuf> {
     files
 }
 
-/// The `n`th screenshot (counting from 1), once the viewer has written it.
-fn shot(dir: &Path, n: usize) -> PathBuf {
-    until(Duration::from_secs(10), || {
-        let files = screenshots(dir);
-        // A file being written may not decode yet: wait for one that does.
-        files.get(n - 1).filter(|p| image::open(p).is_ok()).cloned()
-    })
-    .unwrap_or_else(|| panic!("screenshot {n} did not appear in {}", dir.display()))
+/// Keys sent to the viewer so that it cannot miss them however slowly it draws: a key is
+/// held down until the screenshot it comes with has appeared.
+struct Keys<'a> {
+    display: &'a str,
+    shots: &'a Path,
+}
+
+impl Keys<'_> {
+    /// Holds `keys` (each pressed once) and presses SPACE until a new screenshot has been
+    /// written, then releases them all; returns the screenshot. A SPACE released and pressed
+    /// again within one frame is not seen, so it is pressed again after a pause until a
+    /// screenshot comes (at most two minutes: a hung viewer, not a slow one).
+    fn shoot(&self, keys: &[&str]) -> PathBuf {
+        let before = screenshots(self.shots).len();
+        for k in keys {
+            xdotool(self.display, &["keydown", k]).expect("press a key");
+        }
+        let started = Instant::now();
+        let mut taken = None;
+        while taken.is_none() && started.elapsed() < Duration::from_secs(120) {
+            xdotool(self.display, &["keydown", "space"]).expect("press space");
+            taken = until(Duration::from_secs(5), || {
+                let files = screenshots(self.shots);
+                // A file being written may not decode yet: wait for one that does.
+                files
+                    .get(before)
+                    .filter(|p| image::open(p).is_ok())
+                    .cloned()
+            });
+            xdotool(self.display, &["keyup", "space"]).expect("release space");
+            sleep(Duration::from_millis(200));
+        }
+        for k in keys.iter().rev() {
+            xdotool(self.display, &["keyup", k]).expect("release a key");
+        }
+        taken.unwrap_or_else(|| panic!("no screenshot appeared in {}", self.shots.display()))
+    }
+
+    /// TAB until a screenshot shows `scene`: a TAB pressed again right after its release can
+    /// fall in the frame that saw the release and go unseen, and then the screenshot still
+    /// shows the scene before; the next try comes after that screenshot's frame.
+    fn switch_to(&self, scene: &str) -> PathBuf {
+        for _ in 0..10 {
+            let shot = self.shoot(&["Tab"]);
+            let name = shot.file_name().unwrap().to_string_lossy().into_owned();
+            if name.starts_with(&format!("hooke-{scene}-")) {
+                return shot;
+            }
+        }
+        panic!("TAB did not reach {scene} in ten tries");
+    }
 }
 
 fn load(p: &Path) -> RgbaImage {
@@ -165,8 +211,17 @@ fn viewer_animates_tab_switches_scenes_and_w_stills_the_wind_under_xvfb() {
             let number = 40 + (std::process::id() + k) % 50;
             let display = format!(":{number}");
             let mut x = Reaper(
+                // `-r`: no autorepeat, so a key held until the viewer has seen it is one press.
                 Command::new("Xvfb")
-                    .args([&display, "-screen", "0", "800x600x24", "-nolisten", "tcp"])
+                    .args([
+                        &display,
+                        "-screen",
+                        "0",
+                        "800x600x24",
+                        "-nolisten",
+                        "tcp",
+                        "-r",
+                    ])
                     .stdout(Stdio::null())
                     .stderr(Stdio::null())
                     .spawn()
@@ -190,6 +245,8 @@ fn viewer_animates_tab_switches_scenes_and_w_stills_the_wind_under_xvfb() {
     let _ = std::fs::remove_dir_all(&shots);
     std::fs::create_dir_all(&shots).unwrap();
     let shots_arg = shots.to_string_lossy().into_owned();
+    // A fixed clock of 1/30 s of simulated time per frame: what the screenshots show depends
+    // on the frames drawn, not on how fast a loaded machine draws them.
     let (mut viewer, window) = open_viewer(
         &display,
         &[
@@ -199,39 +256,46 @@ fn viewer_animates_tab_switches_scenes_and_w_stills_the_wind_under_xvfb() {
             "flag",
             "--size",
             "400x300",
+            "--clock",
+            "0.0333",
             "--screenshots",
             &shots_arg,
         ],
     );
     xdotool(&display, &["windowfocus", "--sync", &window]).expect("focus the window");
-
-    // Key taps are held 100 ms so that a frame sees them down.
-    let key = |k: &str| {
-        xdotool(&display, &["key", "--delay", "100", k]).expect("send a key");
-        sleep(Duration::from_millis(300));
+    let keys = Keys {
+        display: &display,
+        shots: &shots,
     };
-    sleep(Duration::from_millis(500));
-    key("space");
-    sleep(Duration::from_millis(700));
-    key("space");
-    key("Tab");
-    sleep(Duration::from_millis(500));
-    key("space");
-    // The flag streams in its wind; W turns the wind off and it drops against the pole.
-    // How soon the flag has streamed out, and later dropped, depends on the frame rate a
-    // loaded machine gives the viewer (its simulation keeps to a share of each frame, so
-    // simulated time falls behind the clock): a screenshot a second until it has, for at
-    // most eight seconds out and fifteen down.
-    key("Tab");
+
+    let a = keys.shoot(&[]);
+    // The cloth swings: a later screenshot differs (after however many frames that takes).
     let (top, bottom) = (20, 300 - 32);
-    let mut n = 3;
-    let mut windy = 0;
-    for _ in 0..8 {
-        sleep(Duration::from_millis(1000));
-        key("space");
-        n += 1;
-        let width = flag_width(&load(&shot(&shots, n)), top, bottom);
-        // Out once it no longer grows.
+    let mut moved = 0;
+    let mut b = a.clone();
+    for _ in 0..30 {
+        b = keys.shoot(&[]);
+        moved = changed(&load(&a), &load(&b), top, bottom);
+        if moved > 500 {
+            break;
+        }
+    }
+    assert!(
+        moved > 500,
+        "the cloth should swing between screenshots: {moved} pixels changed"
+    );
+    let c = keys.switch_to("chain");
+    let switched = changed(&load(&b), &load(&c), top, bottom);
+    assert!(
+        switched > 5000,
+        "TAB should show another scene: {switched} pixels changed"
+    );
+    // The flag streams in its wind; W turns the wind off and it drops against the pole.
+    // Screenshots until the flag has streamed out (it no longer grows), then until it has
+    // dropped: bounded in count, and each a number of frames, so the same on any machine.
+    let mut windy = flag_width(&load(&keys.switch_to("flag")), top, bottom);
+    for _ in 0..60 {
+        let width = flag_width(&load(&keys.shoot(&[])), top, bottom);
         if windy > 60 && width <= windy + 2 {
             windy = windy.max(width);
             break;
@@ -242,27 +306,24 @@ fn viewer_animates_tab_switches_scenes_and_w_stills_the_wind_under_xvfb() {
         windy > 60,
         "the flag should stream in its wind: it spans {windy} columns"
     );
-    key("w");
-    let mut calm = windy;
-    for _ in 0..15 {
-        n += 1;
-        sleep(Duration::from_millis(1000));
-        key("space");
-        calm = calm.min(flag_width(&load(&shot(&shots, n)), top, bottom));
+    let mut calm = flag_width(&load(&keys.shoot(&["w"])), top, bottom);
+    for _ in 0..120 {
         if calm * 5 < windy * 3 {
             break;
         }
+        calm = calm.min(flag_width(&load(&keys.shoot(&[])), top, bottom));
     }
     assert!(
         calm * 5 < windy * 3,
         "W should still the wind: the flag spans {windy} columns in the wind, {calm} without"
     );
-    key("Escape");
-
-    let status = until(Duration::from_secs(10), || {
+    // Held until the viewer has gone: it reads ESC's state once a frame.
+    xdotool(&display, &["keydown", "Escape"]).expect("press Escape");
+    let status = until(Duration::from_secs(120), || {
         viewer.0.try_wait().ok().flatten()
-    })
-    .expect("the viewer did not quit on Escape");
+    });
+    let _ = xdotool(&display, &["keyup", "Escape"]);
+    let status = status.expect("the viewer did not quit on Escape");
     assert!(status.success(), "viewer exit status {status}");
 
     let files = screenshots(&shots);
@@ -270,34 +331,15 @@ fn viewer_animates_tab_switches_scenes_and_w_stills_the_wind_under_xvfb() {
         .iter()
         .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
         .collect();
-    assert_eq!(
-        names[..4],
-        [
-            "hooke-hanging-cloth-001.png",
-            "hooke-hanging-cloth-002.png",
-            "hooke-chain-003.png",
-            "hooke-flag-004.png",
-        ],
-        "screenshots in {}",
-        shots.display()
-    );
-    assert!(
-        names[4..].iter().all(|n| n.starts_with("hooke-flag-")),
-        "screenshots after W: {names:?}"
-    );
-    let [a, b, c] = [&files[0], &files[1], &files[2]].map(|p| load(p));
-    assert_eq!(a.dimensions(), (400, 300));
-    // Between the status line (rows 0..20) and the help lines (the last 32 rows).
-    let moved = changed(&a, &b, top, bottom);
-    assert!(
-        moved > 500,
-        "the cloth should swing between screenshots 0.7 s apart: {moved} pixels changed"
-    );
-    let switched = changed(&b, &c, top, bottom);
-    assert!(
-        switched > 5000,
-        "TAB should show another scene: {switched} pixels changed"
-    );
+    // The hanging cloth until TAB, the chain, then the flag.
+    let scene = |n: &str| {
+        let rest = n.trim_start_matches("hooke-");
+        rest.rsplit_once('-').map_or(rest, |(s, _)| s).to_string()
+    };
+    let mut order: Vec<String> = names.iter().map(|n| scene(n)).collect();
+    order.dedup();
+    assert_eq!(order, ["hanging-cloth", "chain", "flag"], "{names:?}");
+    assert_eq!(load(&files[0]).dimensions(), (400, 300));
 
     // Ctrl-C closes the viewer with the status every interrupted command has.
     let (mut viewer, _) = open_viewer(&display, &["view", "chain", "--size", "200x150"]);

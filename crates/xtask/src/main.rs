@@ -251,44 +251,57 @@ fn install_package(python: &Path) -> Result<(), String> {
     }
 }
 
-/// The exit code of a finished command.
-fn code(status: std::process::ExitStatus) -> ExitCode {
-    match status.code() {
-        Some(0) => ExitCode::SUCCESS,
-        Some(code) => ExitCode::from(u8::try_from(code).unwrap_or(1)),
-        None => ExitCode::FAILURE,
-    }
-}
-
-/// `cargo test --workspace` with `args`, with this cargo and `python` as `HOOKE_PYTHON`;
-/// then, when no arguments narrowed the run, the Python package's tests with pytest.
+/// `cargo test --workspace --no-fail-fast` with `args`, with this cargo and `python` as
+/// `HOOKE_PYTHON`; then, when no arguments narrowed the run, the Python package's tests with
+/// pytest. Every suite runs even when an earlier one fails (a failing test binary does not
+/// stop the others), and the failures are listed together at the end.
 fn test(args: &[String], python: &Path) -> Result<ExitCode, String> {
-    install_package(python)?;
+    let mut failed: Vec<String> = Vec::new();
+    let installed = install_package(python);
+    if let Err(e) = &installed {
+        failed.push(format!("building the Python package: {e}"));
+    }
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let status = Command::new(cargo)
-        .args(["test", "--workspace"])
+        .args(["test", "--workspace", "--no-fail-fast"])
         .args(args)
         .env("HOOKE_PYTHON", python)
         .status()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {
-        return Ok(code(status));
+        failed.push(format!(
+            "cargo test --workspace ({status}): the failing tests and test binaries are listed \
+             above"
+        ));
     }
     if !args.is_empty() {
         eprintln!(
             "xtask: arguments given, so python/tests did not run (run them with no arguments)"
         );
+    } else if installed.is_ok() {
+        // The command the bit-for-bit tests compare with: the one cargo test just built.
+        let target = std::env::var_os("CARGO_TARGET_DIR")
+            .map_or_else(|| root().join("target"), PathBuf::from);
+        let status = Command::new(python)
+            .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
+            .arg(root().join("python/tests"))
+            .env("HOOKE_BIN", target.join("debug/hooke"))
+            .current_dir(root())
+            .status()
+            .map_err(|e| format!("cannot run pytest: {e}"))?;
+        if !status.success() {
+            failed.push(format!(
+                "pytest python/tests ({status}): the failing tests are listed above"
+            ));
+        }
+    }
+    if failed.is_empty() {
+        eprintln!("xtask: every test suite passed");
         return Ok(ExitCode::SUCCESS);
     }
-    // The command the bit-for-bit tests compare with: the one cargo test just built.
-    let target =
-        std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root().join("target"), PathBuf::from);
-    let status = Command::new(python)
-        .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
-        .arg(root().join("python/tests"))
-        .env("HOOKE_BIN", target.join("debug/hooke"))
-        .current_dir(root())
-        .status()
-        .map_err(|e| format!("cannot run pytest: {e}"))?;
-    Ok(code(status))
+    eprintln!("xtask: {} suite(s) failed:", failed.len());
+    for f in &failed {
+        eprintln!("  - {f}");
+    }
+    Ok(ExitCode::FAILURE)
 }

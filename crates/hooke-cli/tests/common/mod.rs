@@ -82,14 +82,68 @@ pub fn temporaries(dir: &Path) -> Vec<PathBuf> {
     out
 }
 
-/// Waits until `ready()` or panics after a minute (a slow machine, not a hang, is expected).
+/// Waits until `ready()`, or panics after five minutes: a hung process, not a slow machine
+/// (the tests run on loaded machines, and nothing here depends on their speed).
 pub fn wait_for(what: &str, mut ready: impl FnMut() -> bool) {
     let start = Instant::now();
     while !ready() {
         assert!(
-            start.elapsed() < Duration::from_secs(60),
+            start.elapsed() < Duration::from_secs(300),
             "timed out waiting for {what}"
         );
         std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// A running `hooke` whose stderr is read as it comes, so that a test can wait for what it
+/// says instead of sleeping.
+pub struct Watched {
+    /// The process.
+    pub child: Child,
+    said: std::sync::Arc<std::sync::Mutex<String>>,
+    reader: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Watched {
+    /// Starts `hooke ARGS` in `dir`.
+    pub fn spawn(args: &[&str], dir: &Path) -> Self {
+        use std::io::Read;
+        let mut child = spawn(args, dir);
+        let mut err = child.stderr.take().unwrap();
+        let said = std::sync::Arc::new(std::sync::Mutex::new(String::new()));
+        let sink = said.clone();
+        let reader = std::thread::spawn(move || {
+            let mut buf = [0u8; 4096];
+            while let Ok(n) = err.read(&mut buf) {
+                if n == 0 {
+                    break;
+                }
+                sink.lock()
+                    .unwrap()
+                    .push_str(&String::from_utf8_lossy(&buf[..n]));
+            }
+        });
+        Self {
+            child,
+            said,
+            reader: Some(reader),
+        }
+    }
+
+    /// Waits until stderr holds `text`.
+    pub fn wait_to_say(&self, text: &str) {
+        wait_for(&format!("stderr to say {text:?}"), || {
+            self.said.lock().unwrap().contains(text)
+        });
+    }
+
+    /// Waits for the end: the exit status and all of stderr.
+    pub fn finish(mut self) -> (std::process::ExitStatus, String) {
+        let status = self.child.wait().unwrap();
+        if let Some(r) = self.reader.take() {
+            r.join().unwrap();
+        }
+        let said = self.said.lock().unwrap().clone();
+        (status, said)
     }
 }
