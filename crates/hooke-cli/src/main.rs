@@ -239,7 +239,7 @@ fn dispatch(command: Command) -> Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Command::Scene { name } => {
-            let spec = source::read(&name)?.spec;
+            let spec = source::read(&name)?.spec.with_contact_defaults();
             print!("{}", hooke_scene::to_toml(&spec));
             Ok(ExitCode::SUCCESS)
         }

@@ -279,7 +279,22 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         }
         return Ok(ExitCode::from(interrupt::EXIT_INTERRUPTED));
     }
-    result?;
+    if let Err(e) = result {
+        // Stiff springs are the usual cause; a strong wind is the other one a scene sets.
+        let wind = scene
+            .simulation
+            .model()
+            .air
+            .as_ref()
+            .map(|air| air.wind.norm() + air.gust.as_ref().map_or(0.0, |g| g.amplitude.norm()));
+        return Err(match wind {
+            Some(w) if is_divergence(&e) && w > 0.0 => e.context(format!(
+                "the scene's air blows at up to {w:.1} m/s: a strong wind needs a small dt as \
+                 much as stiff springs do"
+            )),
+            _ => e,
+        });
+    }
     let sim = &scene.simulation;
     eprintln!(
         "{}: {} steps of {} s with {} ({} s simulated), {} particles, {} springs",

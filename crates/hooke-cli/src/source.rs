@@ -177,5 +177,10 @@ pub fn build_prepared(source: Source, arg: &str) -> Result<Scene> {
         .build(&source.base)
         .with_context(|| format!("scene '{arg}'"));
     spinner.finish_and_clear();
+    if let Ok(scene) = &scene {
+        for warning in scene.warnings() {
+            eprintln!("warning: scene '{arg}': {warning}");
+        }
+    }
     scene
 }

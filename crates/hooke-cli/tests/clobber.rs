@@ -47,14 +47,43 @@ fn devices_fifos_and_standard_output_are_written_through() {
     std::fs::set_permissions(&dir, std::os::unix::fs::PermissionsExt::from_mode(0o777)).unwrap();
     let before = device("/dev/null");
     for args in [
-        &["run", "chain", "--duration", "0.01", "--trajectory", "/dev/null"][..],
-        &["run", "chain", "--duration", "0.01", "--gif", "/dev/null", "--size", "32x24"],
-        &["render", "chain", "--at", "0.01", "-o", "/dev/null", "--size", "32x24"],
+        &[
+            "run",
+            "chain",
+            "--duration",
+            "0.01",
+            "--trajectory",
+            "/dev/null",
+        ][..],
+        &[
+            "run",
+            "chain",
+            "--duration",
+            "0.01",
+            "--gif",
+            "/dev/null",
+            "--size",
+            "32x24",
+        ],
+        &[
+            "render",
+            "chain",
+            "--at",
+            "0.01",
+            "-o",
+            "/dev/null",
+            "--size",
+            "32x24",
+        ],
     ] {
         let out = hooke(args, &dir);
         assert!(out.status.success(), "{args:?}: {}", stderr(&out));
         if let Some(out) = as_nobody(args, &dir) {
-            assert!(out.status.success(), "as nobody, {args:?}: {}", stderr(&out));
+            assert!(
+                out.status.success(),
+                "as nobody, {args:?}: {}",
+                stderr(&out)
+            );
         }
     }
     assert_eq!(device("/dev/null"), before);
@@ -62,7 +91,14 @@ fn devices_fifos_and_standard_output_are_written_through() {
     // /dev/full: the write fails and says so; the device stays.
     let full = device("/dev/full");
     let out = hooke(
-        &["run", "chain", "--duration", "0.01", "--trajectory", "/dev/full"],
+        &[
+            "run",
+            "chain",
+            "--duration",
+            "0.01",
+            "--trajectory",
+            "/dev/full",
+        ],
         &dir,
     );
     assert!(!out.status.success());
@@ -71,7 +107,16 @@ fn devices_fifos_and_standard_output_are_written_through() {
 
     // `-` is standard output: the whole CSV arrives there.
     let out = hooke(
-        &["run", "chain", "--duration", "0.01", "--every", "10", "--trajectory", "-"],
+        &[
+            "run",
+            "chain",
+            "--duration",
+            "0.01",
+            "--every",
+            "10",
+            "--trajectory",
+            "-",
+        ],
         &dir,
     );
     assert!(out.status.success(), "{}", stderr(&out));
@@ -80,7 +125,14 @@ fn devices_fifos_and_standard_output_are_written_through() {
     assert_eq!(csv.lines().count(), 1 + 6 * 12, "{csv}");
     // /dev/stdout with standard output on a pipe is that pipe.
     let out = hooke(
-        &["run", "chain", "--duration", "0.01", "--trajectory", "/dev/stdout"],
+        &[
+            "run",
+            "chain",
+            "--duration",
+            "0.01",
+            "--trajectory",
+            "/dev/stdout",
+        ],
         &dir,
     );
     assert!(out.status.success(), "{}", stderr(&out));
@@ -128,20 +180,57 @@ fn no_output_replaces_an_input_or_another_output() {
     std::fs::rename(dir.join("my.obj"), dir.join("scenes/my.obj")).unwrap();
     std::fs::write(dir.join("s.gif"), "mine").unwrap();
     let cases: [(&[&str], &str); 9] = [
-        (&["run", "s.toml", "--trajectory", "s.toml"], "which this run reads"),
-        (&["run", "s.toml", "--trajectory", "./alias.toml"], "which this run reads"),
         (
-            &["run", "cloth-table", "--table", "scenes/my.obj", "--export", "scenes/my.pc2"],
+            &["run", "s.toml", "--trajectory", "s.toml"],
             "which this run reads",
         ),
         (
-            &["run", "scenes/t.toml", "--export", "scenes/../scenes/my.pc2"],
+            &["run", "s.toml", "--trajectory", "./alias.toml"],
             "which this run reads",
         ),
-        (&["run", "chain", "--gif", "s.gif", "--trajectory", "./s.gif"], "same file"),
-        (&["run", "chain", "--trajectory", "a.usda", "--export", "a.usda"], "same file"),
-        (&["run", "chain", "--trajectory", "-", "--summary"], "standard output"),
-        (&["render", "s.toml", "-o", "alias.toml"], "expected a file name ending in .png"),
+        (
+            &[
+                "run",
+                "cloth-table",
+                "--table",
+                "scenes/my.obj",
+                "--export",
+                "scenes/my.pc2",
+            ],
+            "which this run reads",
+        ),
+        (
+            &[
+                "run",
+                "scenes/t.toml",
+                "--export",
+                "scenes/../scenes/my.pc2",
+            ],
+            "which this run reads",
+        ),
+        (
+            &["run", "chain", "--gif", "s.gif", "--trajectory", "./s.gif"],
+            "same file",
+        ),
+        (
+            &[
+                "run",
+                "chain",
+                "--trajectory",
+                "a.usda",
+                "--export",
+                "a.usda",
+            ],
+            "same file",
+        ),
+        (
+            &["run", "chain", "--trajectory", "-", "--summary"],
+            "standard output",
+        ),
+        (
+            &["render", "s.toml", "-o", "alias.toml"],
+            "expected a file name ending in .png",
+        ),
         (&["convert", "s.toml", "alias.toml"], "which this run reads"),
     ];
     for (args, expect) in cases {
@@ -213,7 +302,16 @@ fn a_frame_folder_is_held_by_one_run_at_a_time() {
     }
     // A folder export into the same folder is refused too.
     let out = hooke(
-        &["run", "chain", "--duration", "0.01", "--export", "f/", "--format", "ply"],
+        &[
+            "run",
+            "chain",
+            "--duration",
+            "0.01",
+            "--export",
+            "f/",
+            "--format",
+            "ply",
+        ],
         &dir,
     );
     assert!(stderr(&out).contains("another run"), "{}", stderr(&out));
@@ -224,7 +322,16 @@ fn a_frame_folder_is_held_by_one_run_at_a_time() {
     child.wait().unwrap();
     std::fs::write(dir.join("f/.hooke-4194305-0.tmp"), "left by a dead run").unwrap();
     let out = hooke(
-        &["run", "chain", "--duration", "0.01", "--frames", "f", "--size", "32x24"],
+        &[
+            "run",
+            "chain",
+            "--duration",
+            "0.01",
+            "--frames",
+            "f",
+            "--size",
+            "32x24",
+        ],
         &dir,
     );
     assert!(out.status.success(), "{}", stderr(&out));
@@ -238,14 +345,22 @@ fn thread_counts_are_bounded_and_long_names_written() {
     let dir = scratch("threads");
     let out = hooke(&["bench", "cloth", "--n", "8", "--threads", "100000"], &dir);
     assert_eq!(out.status.code(), Some(1));
-    assert!(stderr(&out).contains("expected at most"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("expected at most"),
+        "{}",
+        stderr(&out)
+    );
     let out = hooke_in(&dir)
         .args(["run", "chain", "--duration", "0.01"])
         .env("RAYON_NUM_THREADS", "100000")
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
-    assert!(stderr(&out).contains("RAYON_NUM_THREADS"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("RAYON_NUM_THREADS"),
+        "{}",
+        stderr(&out)
+    );
     // A 255-byte name, the longest the file system takes.
     let name = format!("{}.csv", "n".repeat(251));
     let out = hooke(

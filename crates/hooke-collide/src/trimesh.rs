@@ -180,6 +180,18 @@ impl TriMeshCollider {
                     reason: format!("triangle {t:?} names a vertex beyond the {count} it has"),
                 });
             }
+            if !has_area(&part.vertices, &part.triangles) {
+                return Err(MeshError::Build {
+                    path: path.to_path_buf(),
+                    part: part.name,
+                    reason: format!(
+                        "none of its {} triangle{} has an area (the vertices of each lie on a \
+                         line or coincide): a collider needs a surface",
+                        part.triangles.len(),
+                        if part.triangles.len() == 1 { "" } else { "s" }
+                    ),
+                });
+            }
             let mut flags =
                 TriMeshFlags::MERGE_DUPLICATE_VERTICES | TriMeshFlags::DELETE_DEGENERATE_TRIANGLES;
             if closed {
@@ -211,6 +223,11 @@ impl TriMeshCollider {
             label,
             parts: built,
         })
+    }
+
+    /// Number of triangles with an area, over all parts.
+    pub fn triangle_count(&self) -> usize {
+        self.parts.iter().map(|p| p.mesh.indices().len()).sum()
     }
 
     /// Number of parts (objects).
@@ -462,6 +479,19 @@ impl Collider for TriMeshCollider {
             }
         })
     }
+}
+
+/// Whether some triangle has an area that is not lost in rounding at the mesh's size.
+fn has_area(vertices: &[Vec3], triangles: &[[u32; 3]]) -> bool {
+    let (lo, hi) = vertices.iter().fold(
+        (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
+        |(lo, hi), v| (lo.inf(v), hi.sup(v)),
+    );
+    let size = (hi - lo).norm();
+    triangles.iter().any(|t| {
+        let [a, b, c] = t.map(|i| vertices[i as usize]);
+        (b - a).cross(&(c - a)).norm() > 1e-12 * size * size
+    })
 }
 
 #[cfg(test)]

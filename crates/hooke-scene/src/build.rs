@@ -193,6 +193,9 @@ impl SceneSpec {
                 "expected a frame cadence of at least 1 step",
             ));
         }
+        if let Some(air) = &self.simulation.air {
+            check_air(air)?;
+        }
         let mut particles = Particles::default();
         let mut springs = Vec::new();
         let mut bodies = Vec::new();
@@ -388,6 +391,41 @@ impl SceneSpec {
     }
 }
 
+/// The fastest wind a scene may blow, m/s: the speed of sound in air at 20 °C. The air
+/// model is incompressible pressure drag, which means nothing at or beyond it.
+pub const MAX_WIND: f64 = 343.0;
+
+/// Refuses air whose wind (steady plus the gust's largest change) reaches [`MAX_WIND`].
+fn check_air(air: &AirSpec) -> Result<(), BuildError> {
+    let wind = vec3(&air.wind);
+    let gust = air.gust.map_or(Vec3::zeros(), |g| vec3(&g.amplitude));
+    let fastest = wind.norm() + gust.norm();
+    if fastest.is_finite() && fastest < MAX_WIND {
+        return Ok(());
+    }
+    let key = if gust.norm() > wind.norm() {
+        "simulation.air.gust.amplitude"
+    } else {
+        "simulation.air.wind"
+    };
+    let shown = |v: &Vec3| format!("[{}, {}, {}]", Num(v.x), Num(v.y), Num(v.z));
+    Err(invalid(
+        key,
+        format!(
+            "a wind of {} m/s with gusts of {} m/s reaches {} m/s; Hooke's air is \
+             incompressible drag, which means nothing at or beyond the speed of sound: expected \
+             less than {MAX_WIND} m/s in all",
+            shown(&wind),
+            shown(&gust),
+            if fastest.is_finite() {
+                format!("{fastest:.1}")
+            } else {
+                "far beyond any number".to_string()
+            }
+        ),
+    ))
+}
+
 /// The triangles of a body that the air acts on, with its coefficients: none without air.
 fn body_aero(
     body: &BodySpec,
@@ -426,12 +464,23 @@ fn body_surface(
         ShapeSpec::Grid { spacing, .. } => DEFAULT_CLOTH_THICKNESS.min(0.25 * spacing.get()),
         _ => 0.0,
     };
+    // A body without triangles (a chain, points, a grid one particle wide) has no surface:
+    // its default thickness is none, and contact keys written for it are refused by name.
+    let default = if triangles.is_empty() { 0.0 } else { default };
     let thickness = body.thickness.map_or(default, |h| h.get());
-    if thickness > 0.0 && triangles.is_empty() {
-        return Err(invalid(
-            format!("{key}.thickness"),
-            "only bodies with a surface (grid, lattice) have a contact thickness; remove it",
-        ));
+    if triangles.is_empty() {
+        let written = [
+            ("thickness", body.thickness.is_some_and(|h| h.get() > 0.0)),
+            ("self_collision", body.self_collision.is_some()),
+            ("friction", body.friction.is_some()),
+        ];
+        if let Some((name, _)) = written.iter().find(|(_, w)| *w) {
+            return Err(invalid(
+                format!("{key}.{name}"),
+                "only bodies with a surface (a grid or lattice at least 2 particles wide) take \
+                 contact keys; this body has no triangles: remove it",
+            ));
+        }
     }
     let self_collision = body.self_collision.unwrap_or(true);
     let surface = Surface {
@@ -454,9 +503,10 @@ fn body_surface(
             return Err(invalid(
                 format!("{key}.thickness"),
                 format!(
-                    "{thickness} m is not under half the surface's shortest edge ({shortest:.4} m): \
+                    "{} m is not under half the surface's shortest edge ({shortest:.4} m): \
                      self-collision would push neighbouring particles apart; \
-                     use a thinner surface or self_collision = false"
+                     use a thinner surface or self_collision = false",
+                    Num(thickness)
                 ),
             ));
         }
@@ -586,6 +636,30 @@ fn pairs(
 }
 
 impl SceneSpec {
+    /// The scene with the contact keys its surfaces default to written out (`thickness`,
+    /// `self_collision`, `friction` on every body with triangles), so that an emitted scene
+    /// shows them; it builds to the same simulation, bit for bit.
+    pub fn with_contact_defaults(&self) -> SceneSpec {
+        let mut spec = self.clone();
+        for body in &mut spec.bodies {
+            // A grid has triangles when it is two particles wide both ways, a lattice when
+            // two of its sides are (crate::surface::triangles), without making them.
+            let wide = |sides: &[usize]| sides.iter().filter(|&&n| n >= 2).count();
+            let thickness = match &body.shape {
+                ShapeSpec::Grid { size, spacing } if wide(size) == 2 => {
+                    DEFAULT_CLOTH_THICKNESS.min(0.25 * spacing.get())
+                }
+                ShapeSpec::Lattice { size, .. } if wide(size) >= 2 => 0.0,
+                _ => continue,
+            };
+            body.thickness.get_or_insert(NonNegative::of(thickness));
+            body.self_collision.get_or_insert(true);
+            body.friction
+                .get_or_insert(NonNegative::of(DEFAULT_SURFACE_FRICTION));
+        }
+        spec
+    }
+
     /// The files building the scene reads, each with the key that names it
     /// (`collider[2].shape.path`): its mesh files, resolved against `base` (built-in meshes
     /// are no files). For checking, before a run, that no output replaces one.

@@ -27,6 +27,7 @@ pub mod generators;
 mod overrides;
 pub mod spec;
 pub mod surface;
+mod suspicious;
 mod tagged;
 pub mod workload;
 pub mod world;
