@@ -87,6 +87,14 @@ def sweep(source: str, grid: Mapping[str, Sequence[Any]], metric: Callable[[Simu
     `RAY_ADDRESS`), `"serial"` this process, or any `concurrent.futures.Executor`.
     The results do not depend on where the points ran: each point is the same computation.
     """
+    if isinstance(executor, str) and executor not in ("serial", "ray"):
+        raise HookeError(
+            f"executor: expected None, 'serial', 'ray' or a concurrent.futures.Executor, "
+            f"found {executor!r}")
+    if executor is not None and not isinstance(executor, str) and not hasattr(executor, "submit"):
+        raise HookeError(
+            f"executor: expected None, 'serial', 'ray' or a concurrent.futures.Executor, "
+            f"found {type(executor).__name__}")
     points = _points(grid)
     if executor == "serial":
         values = [run_point(source, p, metric, fixed) for p in points]

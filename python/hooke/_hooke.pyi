@@ -12,7 +12,8 @@ class DivergenceError(HookeError):
     """The state stopped making sense; the message names the step, particle and a stable dt."""
 
 class Simulation:
-    """A scene being simulated."""
+    """A scene being simulated. One thread uses it at a time: a call while another thread's
+    call on it runs raises HookeError."""
 
     def step(self, n: int = 1) -> None:
         """Advances `n` steps; KeyboardInterrupt on Ctrl-C after a whole step."""

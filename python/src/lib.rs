@@ -38,14 +38,14 @@ create_exception!(
 const ARGUMENT_NAMES: [(&str, &str); 10] = [
     ("--format ply", "format=\"ply\""),
     ("--format obj", "format=\"obj\""),
-    ("--format", "format="),
+    ("--format", "format"),
     ("--export (its mesh)", "export (its mesh)"),
     ("--export", "export path"),
-    ("--body", "body="),
-    ("--table", "table="),
-    ("--threads", "threads="),
-    ("--dt", "dt="),
-    ("--duration", "duration="),
+    ("--body", "body"),
+    ("--table", "table"),
+    ("--threads", "threads"),
+    ("--dt", "dt"),
+    ("--duration", "duration"),
 ];
 
 /// `message` with the command line's option names replaced by [`ARGUMENT_NAMES`].

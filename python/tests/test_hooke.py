@@ -104,12 +104,51 @@ def test_bad_input_raises_with_the_file_line_or_key(tmp_path):
         hooke.load("chain", dt=-1.0)
     with pytest.raises(hooke.HookeError, match="springz"):
         hooke.load("hanging-cloth", set={"body.springz.ks": 1.0})
-    with pytest.raises(hooke.HookeError, match="--table nope.obj: no such file"):
+    with pytest.raises(hooke.HookeError, match="table nope.obj: no such file"):
         hooke.load("cloth-table", table="nope.obj")
     with pytest.raises(TypeError):
         hooke.load("chain", stiffness=3)
     with pytest.raises(hooke.DivergenceError, match=r"diverged at step \d+ .* use dt = "):
         hooke.load("chain", dt=10.0).advance(100.0)
+
+
+def test_bad_counts_threads_and_executors_raise_hooke_error():
+    sim = hooke.load("chain")
+    for call in (lambda: sim.step(-1), lambda: sim.render(-1, 5),
+                 lambda: hooke.load("chain", threads=100000),
+                 lambda: hooke.load("chain", steps=-3),
+                 lambda: hooke.sweep("chain", {"dt": [1e-4]}, hooke.metrics.lowest_point,
+                                     executor="bogus")):
+        with pytest.raises(hooke.HookeError):
+            call()
+    # Messages name the Python arguments, not the command line's options.
+    with pytest.raises(hooke.HookeError) as e:
+        sim.export(str(ROOT / "target" / "no-such-folder-xyz") + "/")
+    assert "--" not in str(e.value) and 'format="ply"' in str(e.value), str(e.value)
+
+
+def test_a_simulation_used_from_two_threads_says_so():
+    sim = hooke.load("cloth-table")
+    errors = []
+    started = threading.Event()
+
+    def long_run():
+        started.set()
+        sim.advance(0.3)
+
+    t = threading.Thread(target=long_run)
+    t.start()
+    started.wait()
+    # While the other thread steps (the GIL released), every call here is refused.
+    deadline = time.monotonic() + 60
+    while t.is_alive() and not errors and time.monotonic() < deadline:
+        try:
+            sim.positions
+        except hooke.HookeError as e:
+            errors.append(str(e))
+    t.join()
+    assert errors and "another thread" in errors[0], errors
+    assert sim.steps_taken == round(0.3 / sim.dt)
 
 
 def test_scene_keys_change_the_physics():
@@ -140,7 +179,7 @@ def test_export_writes_what_the_command_writes(tmp_path):
     stage = pxr.Usd.Stage.Open(str(tmp_path / "c.usda"))
     assert stage.GetEndTimeCode() == 10
     assert sim.steps_taken == 400
-    with pytest.raises(hooke.HookeError, match="a folder export needs --format"):
+    with pytest.raises(hooke.HookeError, match='a folder export needs format="ply" or format="obj"'):
         sim.export(str(tmp_path) + "/")
 
 

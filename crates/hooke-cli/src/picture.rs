@@ -108,11 +108,19 @@ fn animate(
     };
     let path = out.join(format!("{name}.gif"));
     let mut gif = GifWriter::create(&path, small.size, (interval * 1000.0).round() as u32)?;
-    drive(&mut scene, |_, scene| {
+    let result = drive(&mut scene, |_, scene| {
         gif.frame(small.pixels(scene, camera))
-    })?;
+    });
     let count = gif.frames();
-    gif.finish()?;
+    // Interrupted, the animation still ends at its last whole frame, as a run's GIF does.
+    if result.is_ok()
+        || result
+            .as_ref()
+            .is_err_and(hooke_cli::interrupt::is_interrupt)
+    {
+        gif.finish()?;
+    }
+    result?;
     eprintln!(
         "{name:<14} animation of {count} frames -> {}",
         path.display()

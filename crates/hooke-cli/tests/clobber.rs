@@ -36,6 +36,14 @@ fn as_nobody(args: &[&str], dir: &Path) -> Option<Output> {
     )
 }
 
+/// `hooke run chain` for a hundredth of a second, its trajectory to `path`.
+fn chain_to(path: &str, dir: &Path) -> Output {
+    hooke(
+        &["run", "chain", "--duration", "0.01", "--trajectory", path],
+        dir,
+    )
+}
+
 fn device(path: &str) -> (u64, u64, bool) {
     let m = std::fs::metadata(path).unwrap();
     (m.ino(), m.rdev(), m.file_type().is_char_device())
@@ -90,17 +98,7 @@ fn devices_fifos_and_standard_output_are_written_through() {
     assert!(before.2);
     // /dev/full: the write fails and says so; the device stays.
     let full = device("/dev/full");
-    let out = hooke(
-        &[
-            "run",
-            "chain",
-            "--duration",
-            "0.01",
-            "--trajectory",
-            "/dev/full",
-        ],
-        &dir,
-    );
+    let out = chain_to("/dev/full", &dir);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("No space left"), "{}", stderr(&out));
     assert_eq!(device("/dev/full"), full);
@@ -124,17 +122,7 @@ fn devices_fifos_and_standard_output_are_written_through() {
     assert!(csv.starts_with("frame,time,particle"), "{csv}");
     assert_eq!(csv.lines().count(), 1 + 6 * 12, "{csv}");
     // /dev/stdout with standard output on a pipe is that pipe.
-    let out = hooke(
-        &[
-            "run",
-            "chain",
-            "--duration",
-            "0.01",
-            "--trajectory",
-            "/dev/stdout",
-        ],
-        &dir,
-    );
+    let out = chain_to("/dev/stdout", &dir);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(String::from_utf8_lossy(&out.stdout).starts_with("frame,"));
 
@@ -151,10 +139,7 @@ fn devices_fifos_and_standard_output_are_written_through() {
         let fifo = fifo.clone();
         std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap())
     };
-    let out = hooke(
-        &["run", "chain", "--duration", "0.01", "--trajectory", "pipe"],
-        &dir,
-    );
+    let out = chain_to("pipe", &dir);
     assert!(out.status.success(), "{}", stderr(&out));
     let rows = reader.join().unwrap();
     assert_eq!(rows.lines().count(), 1 + 12, "{rows}");

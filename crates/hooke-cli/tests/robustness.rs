@@ -531,3 +531,28 @@ mod picture_arguments {
         );
     }
 }
+
+/// An interrupted demo keeps the animation it was writing, ended at its last whole frame.
+#[test]
+fn an_interrupted_demo_keeps_its_animation_up_to_the_last_frame() {
+    let dir = scratch("demo-gif");
+    let watched = Watched::spawn(&["demo", "--out", "d", "--size", "160x120"], &dir);
+    // The animation follows the hanging cloth's still; it is under way once its temporary
+    // file holds a few frames.
+    wait_for("the animation to be under way", || {
+        dir.join("d/4-hanging-cloth.png").exists()
+            && std::fs::read_dir(dir.join("d")).is_ok_and(|d| {
+                d.flatten().any(|e| {
+                    e.file_name().to_string_lossy().ends_with(".tmp")
+                        && e.metadata().is_ok_and(|m| m.len() > 4096)
+                })
+            })
+    });
+    interrupt(&watched.child);
+    let (status, said) = watched.finish();
+    assert_eq!(status.code(), Some(130), "{said}");
+    let frames = gif_frames(&dir.join("d/hanging-cloth.gif"));
+    assert!(frames >= 1, "{frames} frames");
+    assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());
+    let _ = std::fs::remove_dir_all(&dir);
+}
