@@ -87,7 +87,8 @@ fn render_and_demo_stop_on_interrupt_with_status_130() {
             dir.join("d/1-single-spring.png").exists()
         })
     };
-    let cases: [(&[&str], &dyn Fn(&Watched)); 2] = [
+    type UnderWay<'a> = &'a dyn Fn(&Watched);
+    let cases: [(&[&str], UnderWay); 2] = [
         (
             &["render", "chain", "--at", "1e6", "-o", "z.png"],
             &still_announced,

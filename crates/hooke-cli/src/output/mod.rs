@@ -1,5 +1,5 @@
-//! Outputs: files that appear whole or not at all ([`file`]), streams written straight
-//! through ([`destination`]), outputs checked against inputs and each other before a run
+//! Outputs: files that appear whole or not at all ([`mod@file`]), streams written straight
+//! through ([`mod@destination`]), outputs checked against inputs and each other before a run
 //! ([`claims`]), folders of frames held by one run at a time ([`lock`]). Paths are checked
 //! before a run starts, so that a run never simulates for minutes and then finds it cannot
 //! write its result.
