@@ -86,6 +86,8 @@ struct Simulation {
     inner: Mutex<Inner>,
     /// The source it was loaded from, for its repr.
     source: String,
+    /// The files it was built from (scene file, meshes), which no export may replace.
+    inputs: Vec<(String, std::path::PathBuf)>,
 }
 
 /// A simulation's state.
@@ -397,6 +399,13 @@ impl Simulation {
             }
         };
         let target = Target::new(Path::new(path), format, body).map_err(error)?;
+        // No export replaces a file the simulation was built from.
+        let mut claims = hooke_cli::output::claims::Claims::default();
+        for (what, file) in &self.inputs {
+            claims.input(what.clone(), file);
+        }
+        target.claim(&mut claims);
+        claims.check().map_err(error)?;
         let mut inner = self.lock()?;
         let mut exporter = Exporter::create(&target, &inner.scene).map_err(error)?;
         let left = inner
@@ -529,13 +538,14 @@ fn load(
         }
         Some(n) => Some(hooke_cli::threads::pool(Some(n), "threads").map_err(error)?),
     };
-    let scene = Simulation::on_pool(pool.as_ref(), || {
-        source::build_from(read, source, &overrides)
-    })
-    .map_err(error)?;
+    let prepared = source::prepare(read, source, &overrides).map_err(error)?;
+    let inputs = prepared.inputs();
+    let scene = Simulation::on_pool(pool.as_ref(), || source::build_prepared(prepared, source))
+        .map_err(error)?;
     Ok(Simulation {
         inner: Mutex::new(Inner { scene, pool }),
         source: source.to_string(),
+        inputs,
     })
 }
 

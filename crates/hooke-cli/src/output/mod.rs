@@ -70,6 +70,9 @@ pub fn check_output_file(path: &Path, flag: &str, extensions: &[&str]) -> Result
 /// Checks, before a run, that `dir` (given with option `flag`) can be an output folder: it
 /// is one, or nothing is there yet (it is created when the run starts).
 pub fn check_output_folder(dir: &Path, flag: &str) -> Result<()> {
+    if dir.as_os_str() == "-" {
+        bail!("{flag} -: expected a folder; a folder of frames cannot go to standard output");
+    }
     // `file/` does not exist as a path (the file is no folder), but `file` does.
     let text = dir.to_string_lossy();
     let bare = Path::new(text.trim_end_matches(['/', std::path::MAIN_SEPARATOR]));
