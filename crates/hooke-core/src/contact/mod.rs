@@ -182,6 +182,28 @@ pub(crate) struct ContactState {
     feature_ref: Vec<Vec3>,
     point_tri: Vec<[u32; 2]>,
     edge_edge: Vec<[u32; 2]>,
+    /// Per candidate: the sum of its particles' [`ContactState::travel`] below which it
+    /// cannot be within its thickness (see [`ContactState::detect`]); `-inf` until tested.
+    point_tri_budget: Vec<f64>,
+    edge_edge_budget: Vec<f64>,
+    /// Per block of [`BLOCK`] candidates: when it was last tested and its smallest budget
+    /// left then (see [`Block`]).
+    point_tri_blocks: Vec<Block>,
+    edge_edge_blocks: Vec<Block>,
+    /// The sum over detections of the largest travel any particle added: no particle's
+    /// travel has grown by more than its growth since a block was tested.
+    climb: f64,
+    /// Per particle: how far it can have moved relative to the surfaces' common motion
+    /// since the candidate lists were built, metres (an upper bound: the sum of each leg's
+    /// length relative to that leg's mean motion).
+    travel: Vec<f64>,
+    /// Positions at the last detection.
+    x_last: Vec<Vec3>,
+    /// The lists were rebuilt since the last detection: travel starts there.
+    fresh: bool,
+    /// Test every candidate at every detection, budgets or not (for tests that the
+    /// skipping changes nothing).
+    pub(crate) exhaustive: bool,
     feature_pairs: Vec<FeaturePair>,
     /// Boxes at the last build: triangles, then edges.
     tri_box: Vec<(Vec3, Vec3)>,
@@ -382,6 +404,24 @@ impl ContactState {
         self.edge_edge.clear();
         append(&mut self.edge_edge, &scratch);
         self.pair_scratch = scratch;
+        // New lists: every candidate is tested at the next detection, and travel is
+        // counted from here.
+        self.point_tri_budget.clear();
+        self.point_tri_budget
+            .resize(self.point_tri.len(), f64::NEG_INFINITY);
+        self.edge_edge_budget.clear();
+        self.edge_edge_budget
+            .resize(self.edge_edge.len(), f64::NEG_INFINITY);
+        self.travel.clear();
+        self.travel.resize(x.len(), 0.0);
+        self.fresh = true;
+        for (blocks, n) in [
+            (&mut self.point_tri_blocks, self.point_tri.len()),
+            (&mut self.edge_edge_blocks, self.edge_edge.len()),
+        ] {
+            blocks.clear();
+            blocks.resize(n.div_ceil(BLOCK), Block::UNTESTED);
+        }
     }
 
     /// Collider feature–triangle candidates at `x` (after [`ContactState::bin`]).
@@ -432,8 +472,47 @@ impl ContactState {
         self.feature_pairs.sort_by_key(|p| p.tri);
     }
 
+    /// Adds to every surface particle's travel the path since the last detection: the leg
+    /// to this step's start `x0` (the last step's pushes) and the leg to `x` (this step's
+    /// integration), each measured from that leg's mean motion over the surface particles.
+    /// A pair's gap does not change under a motion common to all particles, so between two
+    /// detections it changes by at most the sum of its particles' travel.
+    fn advance_travel(&mut self, x: &[Vec3], x0: &[Vec3]) {
+        if self.fresh || self.x_last.len() != x.len() {
+            self.fresh = false;
+        } else {
+            let n = self.points.len() as f64;
+            let (mut push, mut step) = (Vec3::zeros(), Vec3::zeros());
+            for &p in &self.points {
+                let p = p as usize;
+                push += x0[p] - self.x_last[p];
+                step += x[p] - x0[p];
+            }
+            let (push, step) = (push / n, step / n);
+            let mut most = 0.0_f64;
+            for &p in &self.points {
+                let p = p as usize;
+                let leg = (x0[p] - self.x_last[p] - push).norm() + (x[p] - x0[p] - step).norm();
+                self.travel[p] += leg;
+                most = most.max(leg);
+            }
+            self.climb += most;
+        }
+        self.x_last.clear();
+        self.x_last.extend_from_slice(x);
+    }
+
     /// Appends to `active` every candidate whose gap is under its thickness at `x`, in
     /// candidate order.
+    ///
+    /// A surface pair found at distance `d` at a detection, when its particles' travel
+    /// summed to `T`, stays farther than its thickness `h` while that sum stays below
+    /// `T + d - h`: each particle's travel bounds its motion relative to the common motion,
+    /// and a common motion leaves the gap alone. Its gap at the step's start is then also
+    /// farther than `h` and on the same side (the last leg is part of the travel), so
+    /// [`Stencil::orient`] would give a distance of at least `h` and the pair would not be
+    /// kept: it is not tested until then, and the pairs kept are those a test of every
+    /// candidate keeps.
     fn detect(&mut self, model: &Model, x: &[Vec3], x0: &[Vec3]) {
         let mut scratch = std::mem::take(&mut self.scratch);
         let keep = |mut s: Stencil, out: &mut Vec<Stencil>| {
@@ -459,46 +538,90 @@ impl ContactState {
             }
         });
         append(&mut self.active, &scratch);
-        par_fill(self.point_tri.len(), &mut scratch, |i, out| {
-            let [p, t] = self.point_tri[i];
-            let tri = self.tris[t as usize];
-            let Some((h, mu)) = pair(model, &self.surface_of, p, tri[0]) else {
-                return;
-            };
-            let [ia, ib, ic] = tri.map(|i| i as usize);
-            let w = point_triangle(&x[p as usize], &x[ia], &x[ib], &x[ic]);
-            let s = Stencil {
-                ids: [p, tri[0], tri[1], tri[2]],
-                w: [1.0, -w[0], -w[1], -w[2]],
-                len: 4,
-                anchor: Vec3::zeros(),
-                n: Vec3::zeros(),
-                h,
-                rule: Rule::Coulomb(mu),
-            };
-            keep(s, out);
-        });
+        self.advance_travel(x, x0);
+        let travel = &self.travel;
+        let climb = self.climb;
+        let skip = !self.exhaustive;
+        let mut budgets = std::mem::take(&mut self.point_tri_budget);
+        let mut blocks = std::mem::take(&mut self.point_tri_blocks);
+        par_blocks(
+            &mut scratch,
+            &mut budgets,
+            &mut blocks,
+            skip.then_some(climb),
+            |i, budget, out| {
+                let [p, t] = self.point_tri[i];
+                let tri = self.tris[t as usize];
+                let moved = travel[p as usize]
+                    + travel[tri[0] as usize]
+                    + travel[tri[1] as usize]
+                    + travel[tri[2] as usize];
+                if skip && moved < *budget {
+                    return *budget - moved;
+                }
+                let Some((h, mu)) = pair(model, &self.surface_of, p, tri[0]) else {
+                    *budget = f64::INFINITY;
+                    return f64::INFINITY;
+                };
+                let [ia, ib, ic] = tri.map(|i| i as usize);
+                let w = point_triangle(&x[p as usize], &x[ia], &x[ib], &x[ic]);
+                let s = Stencil {
+                    ids: [p, tri[0], tri[1], tri[2]],
+                    w: [1.0, -w[0], -w[1], -w[2]],
+                    len: 4,
+                    anchor: Vec3::zeros(),
+                    n: Vec3::zeros(),
+                    h,
+                    rule: Rule::Coulomb(mu),
+                };
+                *budget = next_budget(&s, x, moved);
+                keep(s, out);
+                *budget - moved
+            },
+        );
+        self.point_tri_budget = budgets;
+        self.point_tri_blocks = blocks;
         append(&mut self.active, &scratch);
-        par_fill(self.edge_edge.len(), &mut scratch, |i, out| {
-            let [e, f] = self.edge_edge[i];
-            let (ee, ef) = (self.edges[e as usize], self.edges[f as usize]);
-            let Some((h, mu)) = pair(model, &self.surface_of, ee[0], ef[0]) else {
-                return;
-            };
-            let [a, b] = ee.map(|i| x[i as usize]);
-            let [c, d] = ef.map(|i| x[i as usize]);
-            let (s, t) = segment_segment(&a, &b, &c, &d);
-            let st = Stencil {
-                ids: [ee[0], ee[1], ef[0], ef[1]],
-                w: [1.0 - s, s, t - 1.0, -t],
-                len: 4,
-                anchor: Vec3::zeros(),
-                n: Vec3::zeros(),
-                h,
-                rule: Rule::Coulomb(mu),
-            };
-            keep(st, out);
-        });
+        let mut budgets = std::mem::take(&mut self.edge_edge_budget);
+        let mut blocks = std::mem::take(&mut self.edge_edge_blocks);
+        par_blocks(
+            &mut scratch,
+            &mut budgets,
+            &mut blocks,
+            skip.then_some(climb),
+            |i, budget, out| {
+                let [e, f] = self.edge_edge[i];
+                let (ee, ef) = (self.edges[e as usize], self.edges[f as usize]);
+                let moved = travel[ee[0] as usize]
+                    + travel[ee[1] as usize]
+                    + travel[ef[0] as usize]
+                    + travel[ef[1] as usize];
+                if skip && moved < *budget {
+                    return *budget - moved;
+                }
+                let Some((h, mu)) = pair(model, &self.surface_of, ee[0], ef[0]) else {
+                    *budget = f64::INFINITY;
+                    return f64::INFINITY;
+                };
+                let [a, b] = ee.map(|i| x[i as usize]);
+                let [c, d] = ef.map(|i| x[i as usize]);
+                let (s, t) = segment_segment(&a, &b, &c, &d);
+                let st = Stencil {
+                    ids: [ee[0], ee[1], ef[0], ef[1]],
+                    w: [1.0 - s, s, t - 1.0, -t],
+                    len: 4,
+                    anchor: Vec3::zeros(),
+                    n: Vec3::zeros(),
+                    h,
+                    rule: Rule::Coulomb(mu),
+                };
+                *budget = next_budget(&st, x, moved);
+                keep(st, out);
+                *budget - moved
+            },
+        );
+        self.edge_edge_budget = budgets;
+        self.edge_edge_blocks = blocks;
         append(&mut self.active, &scratch);
         self.scratch = scratch;
     }
@@ -541,6 +664,86 @@ fn append<U: Copy>(dst: &mut Vec<U>, bufs: &[Vec<U>]) {
     for b in bufs {
         dst.extend_from_slice(b);
     }
+}
+
+/// The travel sum up to which a pair tested at `x`, with its particles' travel summing to
+/// `moved`, cannot come within its thickness: `moved + d - h` less a margin for rounding
+/// (relative to the distances and travel involved), or `-inf` when it is within it now.
+fn next_budget(s: &Stencil, x: &[Vec3], moved: f64) -> f64 {
+    let d = s.gap(x).norm();
+    let slack = d - s.h - 1e-6 * (d + moved) - 1e-9;
+    if slack > 0.0 {
+        moved + slack
+    } else {
+        f64::NEG_INFINITY
+    }
+}
+
+/// Candidates tested together: a block is skipped whole while no candidate in it can have
+/// used up its budget.
+const BLOCK: usize = 64;
+
+/// A block of candidates: the climb when it was last tested, and the smallest budget left
+/// (budget less the travel sum) among its candidates then.
+#[derive(Clone, Copy, Debug)]
+struct Block {
+    climb: f64,
+    left: f64,
+}
+
+impl Block {
+    const UNTESTED: Self = Self {
+        climb: 0.0,
+        left: f64::NEG_INFINITY,
+    };
+}
+
+/// Calls `f(i, &mut budget[i], out)` for every candidate of a block that may have used up
+/// its budget, in [`CHUNKS`] parallel chunks of whole blocks whose outputs read in order give
+/// what a sequential pass pushes; `f` returns the candidate's budget left. A block is
+/// skipped while four times the climb since its test (a bound on any candidate's travel
+/// sum's growth: four particles, none of whose travel grew by more than the climb) is below
+/// the least budget left in it; with `climb` `None` no block is skipped.
+fn par_blocks<U: Send>(
+    bufs: &mut Vec<Vec<U>>,
+    budgets: &mut [f64],
+    blocks: &mut [Block],
+    climb: Option<f64>,
+    f: impl Fn(usize, &mut f64, &mut Vec<U>) -> f64 + Sync + Send,
+) {
+    // `None`: test every block.
+    let (climb, skip) = (climb.unwrap_or(0.0), climb.is_some());
+    bufs.resize_with(CHUNKS, Vec::new);
+    for b in bufs.iter_mut() {
+        b.clear();
+    }
+    let run = |first: usize, budgets: &mut [f64], blocks: &mut [Block], out: &mut Vec<U>| {
+        for (k, (chunk, block)) in budgets.chunks_mut(BLOCK).zip(blocks).enumerate() {
+            if skip && 4.0 * (climb - block.climb) < block.left {
+                continue;
+            }
+            let start = first + k * BLOCK;
+            let mut left = f64::INFINITY;
+            for (j, budget) in chunk.iter_mut().enumerate() {
+                left = left.min(f(start + j, budget, out));
+            }
+            *block = Block { climb, left };
+        }
+    };
+    let n = budgets.len();
+    if n < PARALLEL_MIN {
+        run(0, budgets, blocks, &mut bufs[0]);
+        return;
+    }
+    let per = blocks.len().div_ceil(CHUNKS);
+    bufs.par_iter_mut()
+        .zip(
+            budgets
+                .par_chunks_mut(per * BLOCK)
+                .zip(blocks.par_chunks_mut(per)),
+        )
+        .enumerate()
+        .for_each(|(k, (out, (budgets, blocks)))| run(k * per * BLOCK, budgets, blocks, out));
 }
 
 /// The closest points of a collider feature and triangle `t` at `x`: the feature's point
