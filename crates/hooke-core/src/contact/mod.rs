@@ -205,11 +205,8 @@ pub(crate) struct ContactState {
     /// skipping changes nothing).
     pub(crate) exhaustive: bool,
     feature_pairs: Vec<FeaturePair>,
-    /// Boxes at the last build: triangles, then edges.
-    tri_box: Vec<(Vec3, Vec3)>,
-    edge_box: Vec<(Vec3, Vec3)>,
-    tri_grid: Grid,
-    edge_grid: Grid,
+    /// Boxes and grids at the last build.
+    bins: Bins,
     features: Vec<(Feature, Rule)>,
     active: Vec<Stencil>,
     /// Per-chunk buffers of the parallel detection and candidate builds.
@@ -311,98 +308,27 @@ impl ContactState {
     /// Bins the triangles' and edges' boxes at `x`, grown by the reach (edges by half).
     fn bin(&mut self, x: &[Vec3]) {
         let reach = self.reach();
-        let bounds = |ids: &[u32]| {
-            ids.iter().fold(
-                (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
-                |(lo, hi), &i| (lo.inf(&x[i as usize]), hi.sup(&x[i as usize])),
-            )
-        };
-        self.tri_box.clear();
-        self.tri_box.extend(self.tris.iter().map(|t| {
-            let (lo, hi) = bounds(t);
-            (lo.add_scalar(-reach), hi.add_scalar(reach))
-        }));
-        self.edge_box.clear();
-        self.edge_box.extend(self.edges.iter().map(|e| {
-            let (lo, hi) = bounds(e);
-            (lo.add_scalar(-0.5 * reach), hi.add_scalar(0.5 * reach))
-        }));
-        let cell = self
-            .tri_box
-            .iter()
-            .chain(&self.edge_box)
-            .map(|(lo, hi)| (hi - lo).max())
-            .fold(reach, f64::max);
-        self.tri_grid.build(cell, self.tri_box.iter().map(|b| b.0));
-        self.edge_grid
-            .build(cell, self.edge_box.iter().map(|b| b.0));
+        self.bins.bin(x, &self.tris, &self.edges, reach);
     }
 
     /// Particle–triangle and edge–edge candidates at `x` (after [`ContactState::bin`]).
     fn build_surface_pairs(&mut self, model: &Model, x: &[Vec3]) {
-        let owners = &self.surface_of;
-        // Exact distances at the build: while no particle moves more than half a skin, no
-        // pair farther apart than the thickness plus the skin can come within the thickness.
-        let reach = self.reach();
-        let reach2 = reach * reach;
         let mut scratch = std::mem::take(&mut self.pair_scratch);
-        let (tris, tri_box, tri_grid) = (&self.tris, &self.tri_box, &self.tri_grid);
-        let (edges, edge_box, edge_grid) = (&self.edges, &self.edge_box, &self.edge_grid);
-
-        // Particle against triangle: the triangle's low cell is the particle's or one below.
-        par_fill(self.points.len(), &mut scratch, |i, out| {
-            let p = self.points[i];
-            let xp = x[p as usize];
-            let c = tri_grid.cell_of(&xp);
-            for d in 0..8 {
-                let cell = [c[0] - (d & 1), c[1] - ((d >> 1) & 1), c[2] - ((d >> 2) & 1)];
-                tri_grid.visit(cell, |t| {
-                    let tri = tris[t as usize];
-                    if !tri.contains(&p)
-                        && inside(&xp, &tri_box[t as usize])
-                        && pair(model, owners, p, tri[0]).is_some()
-                    {
-                        let [a, b, c] = tri.map(|i| x[i as usize]);
-                        let w = point_triangle(&xp, &a, &b, &c);
-                        if (a * w[0] + b * w[1] + c * w[2] - xp).norm_squared() < reach2 {
-                            out.push([p, t]);
-                        }
-                    }
-                });
-            }
-        });
-        self.point_tri.clear();
-        append(&mut self.point_tri, &scratch);
-
-        // Edge against edge: each pair once, from its lower edge, over the edge's own cell
-        // and the 13 neighbours of one half-space (the other 13 see it from theirs).
-        par_fill(edges.len(), &mut scratch, |e, out| {
-            let e = e as u32;
-            let c = edge_grid.item_cell(e);
-            let ee = edges[e as usize];
-            for d in 13..27 {
-                let cell = [c[0] + d % 3 - 1, c[1] + (d / 3) % 3 - 1, c[2] + d / 9 - 1];
-                let own = d == 13;
-                edge_grid.visit(cell, |f| {
-                    let ef = edges[f as usize];
-                    if (!own || f > e)
-                        && !ef.contains(&ee[0])
-                        && !ef.contains(&ee[1])
-                        && overlap(&edge_box[e as usize], &edge_box[f as usize])
-                        && pair(model, owners, ee[0], ef[0]).is_some()
-                    {
-                        let [a, b] = ee.map(|i| x[i as usize]);
-                        let [c, d] = ef.map(|i| x[i as usize]);
-                        let (s, t) = segment_segment(&a, &b, &c, &d);
-                        if (a + (b - a) * s - c - (d - c) * t).norm_squared() < reach2 {
-                            out.push([e, f]);
-                        }
-                    }
-                });
-            }
-        });
-        self.edge_edge.clear();
-        append(&mut self.edge_edge, &scratch);
+        let reach = self.reach();
+        let (mut point_tri, mut edge_edge) = (
+            std::mem::take(&mut self.point_tri),
+            std::mem::take(&mut self.edge_edge),
+        );
+        let prims = Prims {
+            model,
+            owners: &self.surface_of,
+            points: &self.points,
+            tris: &self.tris,
+            edges: &self.edges,
+        };
+        prims.gather(&self.bins, x, reach, &mut scratch, &mut point_tri, &mut edge_edge);
+        self.point_tri = point_tri;
+        self.edge_edge = edge_edge;
         self.pair_scratch = scratch;
         // New lists: every candidate is tested at the next detection, and travel is
         // counted from here.
@@ -433,9 +359,10 @@ impl ContactState {
             return;
         }
         let (lo, hi) = self
+            .bins
             .tri_box
             .iter()
-            .fold((self.tri_box[0].0, self.tri_box[0].1), |(lo, hi), b| {
+            .fold((self.bins.tri_box[0].0, self.bins.tri_box[0].1), |(lo, hi), b| {
                 (lo.inf(&b.0), hi.sup(&b.1))
             });
         for slot in model.colliders.iter().filter(|c| c.shape.has_features()) {
@@ -446,13 +373,13 @@ impl ContactState {
         }
         for &(feature, rule) in &self.features {
             let (flo, fhi) = feature.bounds();
-            let (c0, c1) = (self.tri_grid.cell_of(&flo), self.tri_grid.cell_of(&fhi));
+            let (c0, c1) = (self.bins.tri_grid.cell_of(&flo), self.bins.tri_grid.cell_of(&fhi));
             for i in c0[0] - 1..=c1[0] {
                 for j in c0[1] - 1..=c1[1] {
                     for k in c0[2] - 1..=c1[2] {
-                        let (boxes, pairs) = (&self.tri_box, &mut self.feature_pairs);
+                        let (boxes, pairs) = (&self.bins.tri_box, &mut self.feature_pairs);
                         let tris = &self.tris;
-                        self.tri_grid.visit([i, j, k], |t| {
+                        self.bins.tri_grid.visit([i, j, k], |t| {
                             let b = &boxes[t as usize];
                             if overlap(b, &(flo, fhi))
                                 && feature_gap(&feature, &tris[t as usize], x, reach).is_some()
@@ -624,6 +551,135 @@ impl ContactState {
         self.edge_edge_blocks = blocks;
         append(&mut self.active, &scratch);
         self.scratch = scratch;
+    }
+}
+
+/// A model's contact primitives, for gathering candidate pairs.
+struct Prims<'a> {
+    model: &'a Model,
+    owners: &'a [u32],
+    points: &'a [u32],
+    tris: &'a [[u32; 3]],
+    edges: &'a [[u32; 2]],
+}
+
+impl Prims<'_> {
+    /// Replaces `point_tri` and `edge_edge` with the particle–triangle and edge–edge pairs of
+    /// surfaces that collide nearer than `reach` at `x`, found through `bins` (binned at `x`
+    /// with that reach): by particle, then by the particle's cells and triangle; by edge,
+    /// then by the edge's cells and the other edge.
+    fn gather(
+        &self,
+        bins: &Bins,
+        x: &[Vec3],
+        reach: f64,
+        scratch: &mut Vec<Vec<[u32; 2]>>,
+        point_tri: &mut Vec<[u32; 2]>,
+        edge_edge: &mut Vec<[u32; 2]>,
+    ) {
+        let (model, owners) = (self.model, self.owners);
+        // Exact distances at the build: while no particle moves more than half a skin, no
+        // pair farther apart than the thickness plus the skin can come within the thickness.
+        let reach2 = reach * reach;
+        let (tris, tri_box, tri_grid) = (self.tris, &bins.tri_box, &bins.tri_grid);
+        let (edges, edge_box, edge_grid) = (self.edges, &bins.edge_box, &bins.edge_grid);
+        let points = self.points;
+
+        // Particle against triangle: the triangle's low cell is the particle's or one below.
+        par_fill(points.len(), scratch, |i, out| {
+            let p = points[i];
+            let xp = x[p as usize];
+            let c = tri_grid.cell_of(&xp);
+            for d in 0..8 {
+                let cell = [c[0] - (d & 1), c[1] - ((d >> 1) & 1), c[2] - ((d >> 2) & 1)];
+                tri_grid.visit(cell, |t| {
+                    let tri = tris[t as usize];
+                    if !tri.contains(&p)
+                        && inside(&xp, &tri_box[t as usize])
+                        && pair(model, owners, p, tri[0]).is_some()
+                    {
+                        let [a, b, c] = tri.map(|i| x[i as usize]);
+                        let w = point_triangle(&xp, &a, &b, &c);
+                        if (a * w[0] + b * w[1] + c * w[2] - xp).norm_squared() < reach2 {
+                            out.push([p, t]);
+                        }
+                    }
+                });
+            }
+        });
+        point_tri.clear();
+        append(point_tri, scratch);
+
+        // Edge against edge: each pair once, from its lower edge, over the edge's own cell
+        // and the 13 neighbours of one half-space (the other 13 see it from theirs).
+        par_fill(edges.len(), scratch, |e, out| {
+            let e = e as u32;
+            let c = edge_grid.item_cell(e);
+            let ee = edges[e as usize];
+            for d in 13..27 {
+                let cell = [c[0] + d % 3 - 1, c[1] + (d / 3) % 3 - 1, c[2] + d / 9 - 1];
+                let own = d == 13;
+                edge_grid.visit(cell, |f| {
+                    let ef = edges[f as usize];
+                    if (!own || f > e)
+                        && !ef.contains(&ee[0])
+                        && !ef.contains(&ee[1])
+                        && overlap(&edge_box[e as usize], &edge_box[f as usize])
+                        && pair(model, owners, ee[0], ef[0]).is_some()
+                    {
+                        let [a, b] = ee.map(|i| x[i as usize]);
+                        let [c, d] = ef.map(|i| x[i as usize]);
+                        let (s, t) = segment_segment(&a, &b, &c, &d);
+                        if (a + (b - a) * s - c - (d - c) * t).norm_squared() < reach2 {
+                            out.push([e, f]);
+                        }
+                    }
+                });
+            }
+        });
+        edge_edge.clear();
+        append(edge_edge, scratch);
+    }
+}
+
+/// Boxes of triangles and edges grown by a reach, and grids of them.
+#[derive(Clone, Debug, Default)]
+struct Bins {
+    tri_box: Vec<(Vec3, Vec3)>,
+    edge_box: Vec<(Vec3, Vec3)>,
+    tri_grid: Grid,
+    edge_grid: Grid,
+}
+
+impl Bins {
+    /// Bins the boxes of `tris` and `edges` at `x`, grown by `reach` (edges by half), in
+    /// cells at least as large as the reach and every box.
+    fn bin(&mut self, x: &[Vec3], tris: &[[u32; 3]], edges: &[[u32; 2]], reach: f64) {
+        let bounds = |ids: &[u32]| {
+            ids.iter().fold(
+                (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
+                |(lo, hi), &i| (lo.inf(&x[i as usize]), hi.sup(&x[i as usize])),
+            )
+        };
+        self.tri_box.clear();
+        self.tri_box.extend(tris.iter().map(|t| {
+            let (lo, hi) = bounds(t);
+            (lo.add_scalar(-reach), hi.add_scalar(reach))
+        }));
+        self.edge_box.clear();
+        self.edge_box.extend(edges.iter().map(|e| {
+            let (lo, hi) = bounds(e);
+            (lo.add_scalar(-0.5 * reach), hi.add_scalar(0.5 * reach))
+        }));
+        let cell = self
+            .tri_box
+            .iter()
+            .chain(&self.edge_box)
+            .map(|(lo, hi)| (hi - lo).max())
+            .fold(reach, f64::max);
+        self.tri_grid.build(cell, self.tri_box.iter().map(|b| b.0));
+        self.edge_grid
+            .build(cell, self.edge_box.iter().map(|b| b.0));
     }
 }
 
