@@ -326,7 +326,14 @@ impl ContactState {
             tris: &self.tris,
             edges: &self.edges,
         };
-        prims.gather(&self.bins, x, reach, &mut scratch, &mut point_tri, &mut edge_edge);
+        prims.gather(
+            &self.bins,
+            x,
+            reach,
+            &mut scratch,
+            &mut point_tri,
+            &mut edge_edge,
+        );
         self.point_tri = point_tri;
         self.edge_edge = edge_edge;
         self.pair_scratch = scratch;
@@ -358,13 +365,10 @@ impl ContactState {
         if self.tris.is_empty() {
             return;
         }
-        let (lo, hi) = self
-            .bins
-            .tri_box
-            .iter()
-            .fold((self.bins.tri_box[0].0, self.bins.tri_box[0].1), |(lo, hi), b| {
-                (lo.inf(&b.0), hi.sup(&b.1))
-            });
+        let (lo, hi) = self.bins.tri_box.iter().fold(
+            (self.bins.tri_box[0].0, self.bins.tri_box[0].1),
+            |(lo, hi), b| (lo.inf(&b.0), hi.sup(&b.1)),
+        );
         for slot in model.colliders.iter().filter(|c| c.shape.has_features()) {
             let rule = Rule::of(&slot.response);
             let features = &mut self.features;
@@ -373,7 +377,10 @@ impl ContactState {
         }
         for &(feature, rule) in &self.features {
             let (flo, fhi) = feature.bounds();
-            let (c0, c1) = (self.bins.tri_grid.cell_of(&flo), self.bins.tri_grid.cell_of(&fhi));
+            let (c0, c1) = (
+                self.bins.tri_grid.cell_of(&flo),
+                self.bins.tri_grid.cell_of(&fhi),
+            );
             for i in c0[0] - 1..=c1[0] {
                 for j in c0[1] - 1..=c1[1] {
                     for k in c0[2] - 1..=c1[2] {
