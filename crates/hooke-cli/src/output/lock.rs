@@ -17,6 +17,7 @@ pub const LOCK_NAME: &str = ".hooke-lock";
 /// removed. One process takes a folder once: a second writer of the same run (frames and a
 /// folder export into one folder) shares the handle.
 #[derive(Clone, Debug)]
+// Never read: held for its `Drop`, which releases the folder when the last handle goes.
 pub struct FolderLock(#[allow(dead_code)] Arc<Held>);
 
 #[derive(Debug)]
