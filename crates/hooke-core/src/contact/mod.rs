@@ -95,6 +95,19 @@ struct Stencil {
 }
 
 impl Stencil {
+    /// A surface pair: weights `w` on particles `ids`, kept `h` apart, friction `mu`.
+    fn surface(ids: [u32; 4], w: [f64; 4], h: f64, mu: f64) -> Self {
+        Self {
+            ids,
+            w,
+            len: 4,
+            anchor: Vec3::zeros(),
+            n: Vec3::zeros(),
+            h,
+            rule: Rule::Coulomb(mu),
+        }
+    }
+
     fn gap(&self, x: &[Vec3]) -> Vec3 {
         let mut g = -self.anchor;
         for k in 0..self.len {
@@ -184,12 +197,8 @@ pub(crate) struct ContactState {
     edge_edge: Vec<[u32; 2]>,
     /// Per candidate: the sum of its particles' [`ContactState::travel`] below which it
     /// cannot be within its thickness (see [`ContactState::detect`]); `-inf` until tested.
-    point_tri_budget: Vec<f64>,
-    edge_edge_budget: Vec<f64>,
-    /// Per block of [`BLOCK`] candidates: when it was last tested and its smallest budget
-    /// left then (see [`Block`]).
-    point_tri_blocks: Vec<Block>,
-    edge_edge_blocks: Vec<Block>,
+    point_tri_budget: Budgets,
+    edge_edge_budget: Budgets,
     /// The sum over detections of the largest travel any particle added: no particle's
     /// travel has grown by more than its growth since a block was tested.
     climb: f64,
@@ -339,22 +348,11 @@ impl ContactState {
         self.pair_scratch = scratch;
         // New lists: every candidate is tested at the next detection, and travel is
         // counted from here.
-        self.point_tri_budget.clear();
-        self.point_tri_budget
-            .resize(self.point_tri.len(), f64::NEG_INFINITY);
-        self.edge_edge_budget.clear();
-        self.edge_edge_budget
-            .resize(self.edge_edge.len(), f64::NEG_INFINITY);
+        self.point_tri_budget.reset(self.point_tri.len());
+        self.edge_edge_budget.reset(self.edge_edge.len());
         self.travel.clear();
         self.travel.resize(x.len(), 0.0);
         self.fresh = true;
-        for (blocks, n) in [
-            (&mut self.point_tri_blocks, self.point_tri.len()),
-            (&mut self.edge_edge_blocks, self.edge_edge.len()),
-        ] {
-            blocks.clear();
-            blocks.resize(n.div_ceil(BLOCK), Block::UNTESTED);
-        }
     }
 
     /// Collider feature–triangle candidates at `x` (after [`ContactState::bin`]).
@@ -473,89 +471,62 @@ impl ContactState {
         });
         append(&mut self.active, &scratch);
         self.advance_travel(x, x0);
+        // A tested pair: its new budget, kept if within its thickness; the budget left.
+        let settle = |s: Stencil, moved: f64, budget: &mut f64, out: &mut Vec<Stencil>| {
+            *budget = next_budget(&s, x, moved);
+            keep(s, out);
+            *budget - moved
+        };
         let travel = &self.travel;
         let climb = self.climb;
         let skip = !self.exhaustive;
+        let climb = skip.then_some(climb);
         let mut budgets = std::mem::take(&mut self.point_tri_budget);
-        let mut blocks = std::mem::take(&mut self.point_tri_blocks);
-        par_blocks(
-            &mut scratch,
-            &mut budgets,
-            &mut blocks,
-            skip.then_some(climb),
-            |i, budget, out| {
-                let [p, t] = self.point_tri[i];
-                let tri = self.tris[t as usize];
-                let moved = travel[p as usize]
-                    + travel[tri[0] as usize]
-                    + travel[tri[1] as usize]
-                    + travel[tri[2] as usize];
-                if skip && moved < *budget {
-                    return *budget - moved;
-                }
-                let Some((h, mu)) = pair(model, &self.surface_of, p, tri[0]) else {
-                    *budget = f64::INFINITY;
-                    return f64::INFINITY;
-                };
-                let [ia, ib, ic] = tri.map(|i| i as usize);
-                let w = point_triangle(&x[p as usize], &x[ia], &x[ib], &x[ic]);
-                let s = Stencil {
-                    ids: [p, tri[0], tri[1], tri[2]],
-                    w: [1.0, -w[0], -w[1], -w[2]],
-                    len: 4,
-                    anchor: Vec3::zeros(),
-                    n: Vec3::zeros(),
-                    h,
-                    rule: Rule::Coulomb(mu),
-                };
-                *budget = next_budget(&s, x, moved);
-                keep(s, out);
-                *budget - moved
-            },
-        );
+        budgets.run(&mut scratch, climb, |i, budget, out| {
+            let [p, t] = self.point_tri[i];
+            let tri = self.tris[t as usize];
+            let moved = travel[p as usize]
+                + travel[tri[0] as usize]
+                + travel[tri[1] as usize]
+                + travel[tri[2] as usize];
+            if skip && moved < *budget {
+                return *budget - moved;
+            }
+            let Some((h, mu)) = pair(model, &self.surface_of, p, tri[0]) else {
+                *budget = f64::INFINITY;
+                return f64::INFINITY;
+            };
+            let [ia, ib, ic] = tri.map(|i| i as usize);
+            let w = point_triangle(&x[p as usize], &x[ia], &x[ib], &x[ic]);
+            let ids = [p, tri[0], tri[1], tri[2]];
+            let s = Stencil::surface(ids, [1.0, -w[0], -w[1], -w[2]], h, mu);
+            settle(s, moved, budget, out)
+        });
         self.point_tri_budget = budgets;
-        self.point_tri_blocks = blocks;
         append(&mut self.active, &scratch);
         let mut budgets = std::mem::take(&mut self.edge_edge_budget);
-        let mut blocks = std::mem::take(&mut self.edge_edge_blocks);
-        par_blocks(
-            &mut scratch,
-            &mut budgets,
-            &mut blocks,
-            skip.then_some(climb),
-            |i, budget, out| {
-                let [e, f] = self.edge_edge[i];
-                let (ee, ef) = (self.edges[e as usize], self.edges[f as usize]);
-                let moved = travel[ee[0] as usize]
-                    + travel[ee[1] as usize]
-                    + travel[ef[0] as usize]
-                    + travel[ef[1] as usize];
-                if skip && moved < *budget {
-                    return *budget - moved;
-                }
-                let Some((h, mu)) = pair(model, &self.surface_of, ee[0], ef[0]) else {
-                    *budget = f64::INFINITY;
-                    return f64::INFINITY;
-                };
-                let [a, b] = ee.map(|i| x[i as usize]);
-                let [c, d] = ef.map(|i| x[i as usize]);
-                let (s, t) = segment_segment(&a, &b, &c, &d);
-                let st = Stencil {
-                    ids: [ee[0], ee[1], ef[0], ef[1]],
-                    w: [1.0 - s, s, t - 1.0, -t],
-                    len: 4,
-                    anchor: Vec3::zeros(),
-                    n: Vec3::zeros(),
-                    h,
-                    rule: Rule::Coulomb(mu),
-                };
-                *budget = next_budget(&st, x, moved);
-                keep(st, out);
-                *budget - moved
-            },
-        );
+        budgets.run(&mut scratch, climb, |i, budget, out| {
+            let [e, f] = self.edge_edge[i];
+            let (ee, ef) = (self.edges[e as usize], self.edges[f as usize]);
+            let moved = travel[ee[0] as usize]
+                + travel[ee[1] as usize]
+                + travel[ef[0] as usize]
+                + travel[ef[1] as usize];
+            if skip && moved < *budget {
+                return *budget - moved;
+            }
+            let Some((h, mu)) = pair(model, &self.surface_of, ee[0], ef[0]) else {
+                *budget = f64::INFINITY;
+                return f64::INFINITY;
+            };
+            let [a, b] = ee.map(|i| x[i as usize]);
+            let [c, d] = ef.map(|i| x[i as usize]);
+            let (s, t) = segment_segment(&a, &b, &c, &d);
+            let ids = [ee[0], ee[1], ef[0], ef[1]];
+            let st = Stencil::surface(ids, [1.0 - s, s, t - 1.0, -t], h, mu);
+            settle(st, moved, budget, out)
+        });
         self.edge_edge_budget = budgets;
-        self.edge_edge_blocks = blocks;
         append(&mut self.active, &scratch);
         self.scratch = scratch;
     }
@@ -759,6 +730,34 @@ impl Block {
         climb: 0.0,
         left: f64::NEG_INFINITY,
     };
+}
+
+/// A candidate list's budgets: one per candidate (see [`ContactState::detect`]), and per
+/// block of [`BLOCK`] candidates when it was last tested and its least budget left.
+#[derive(Clone, Debug, Default)]
+struct Budgets {
+    per_pair: Vec<f64>,
+    blocks: Vec<Block>,
+}
+
+impl Budgets {
+    /// Budgets for a new list of `n` candidates: every one untested.
+    fn reset(&mut self, n: usize) {
+        self.per_pair.clear();
+        self.per_pair.resize(n, f64::NEG_INFINITY);
+        self.blocks.clear();
+        self.blocks.resize(n.div_ceil(BLOCK), Block::UNTESTED);
+    }
+
+    /// [`par_blocks`] over these budgets.
+    fn run<U: Send>(
+        &mut self,
+        bufs: &mut Vec<Vec<U>>,
+        climb: Option<f64>,
+        f: impl Fn(usize, &mut f64, &mut Vec<U>) -> f64 + Sync + Send,
+    ) {
+        par_blocks(bufs, &mut self.per_pair, &mut self.blocks, climb, f);
+    }
 }
 
 /// Calls `f(i, &mut budget[i], out)` for every candidate of a block that may have used up
