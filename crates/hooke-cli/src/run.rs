@@ -389,7 +389,14 @@ pub fn convert(input: &Path, output: &Path) -> Result<ExitCode> {
             .unwrap_or("")
             .to_string()
     };
-    let text = match (ext(input).as_str(), ext(output).as_str()) {
+    // A stream (`-`, a device, a FIFO) takes the other format than the input's.
+    let streamed = hooke_cli::output::destination::destination(output, "convert")?.is_stream();
+    let to = match (streamed, ext(input).as_str()) {
+        (true, "w") => "toml".to_string(),
+        (true, "toml") => "w".to_string(),
+        _ => ext(output),
+    };
+    let text = match (ext(input).as_str(), to.as_str()) {
         ("w", "toml") => {
             let world = hooke_scene::world::load_world(input)?;
             let name = input

@@ -121,6 +121,11 @@ fn devices_fifos_and_standard_output_are_written_through() {
     let csv = String::from_utf8(out.stdout).unwrap();
     assert!(csv.starts_with("frame,time,particle"), "{csv}");
     assert_eq!(csv.lines().count(), 1 + 6 * 12, "{csv}");
+    // `convert` to a stream writes the other format than the input's.
+    let world = root_dir().join("assets/worlds/jello.w");
+    let out = hooke(&["convert", &world.to_string_lossy(), "-"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("[simulation]"));
     // /dev/stdout with standard output on a pipe is that pipe.
     let out = chain_to("/dev/stdout", &dir);
     assert!(out.status.success(), "{}", stderr(&out));
