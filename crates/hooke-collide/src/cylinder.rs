@@ -117,6 +117,20 @@ impl Collider for Cylinder {
         sink(contact);
     }
 
+    /// Whether the box, grown by `margin` (and a little for rounding), meets the solid's
+    /// bounds.
+    fn may_touch(&self, lo: &Vec3, hi: &Vec3, margin: f64) -> bool {
+        let c = self.center;
+        let (a, b) = (
+            Vec3::new(c.x - self.radius, c.y - self.thickness, c.z - self.radius),
+            Vec3::new(c.x + self.radius, c.y, c.z + self.radius),
+        );
+        let grow = |v: &Vec3| margin + 1e-9 + 1e-9 * v.amax();
+        let (glo, ghi) = (grow(lo), grow(hi));
+        // Written so that NaN answers `true`.
+        !(0..3).any(|k| lo[k] - glo > b[k] || hi[k] + ghi < a[k])
+    }
+
     /// Inside: the nearest face, `margin` further out. Outside: the nearest point of the
     /// solid (on a face or a rim), when nearer than `margin`.
     fn contacts_within(&self, p: &Vec3, margin: f64, sink: &mut dyn FnMut(Contact)) {

@@ -364,6 +364,18 @@ impl Collider for TriMeshCollider {
 
     /// Inside a solid part: to its nearest surface point and `margin` beyond. Outside any
     /// part (solid or sheet) but nearer than `margin` to it: away from its nearest point.
+    /// Whether the box, grown by `margin` (and a little for rounding), meets the bounds of
+    /// some part: every contact and crossing lies within a part's bounds.
+    fn may_touch(&self, lo: &Vec3, hi: &Vec3, margin: f64) -> bool {
+        let grow = |v: &Vec3| margin + 1e-9 + 1e-9 * v.amax();
+        let (glo, ghi) = (grow(lo), grow(hi));
+        // Written so that NaN answers `true`.
+        self.parts.iter().any(|part| {
+            let (a, b) = (part.aabb.mins, part.aabb.maxs);
+            !(0..3).any(|k| lo[k] - glo > b[k] || hi[k] + ghi < a[k])
+        })
+    }
+
     fn contacts_within(&self, p: &Vec3, margin: f64, sink: &mut dyn FnMut(Contact)) {
         if margin == 0.0 {
             return self.contacts(p, sink);

@@ -67,7 +67,8 @@ pub trait Collider: Debug + Send + Sync {
 
     /// Whether some point of the box `lo..hi` may have a contact within `margin` (with
     /// [`Collider::contacts_within`], or [`Collider::contacts`] for a zero margin, at any
-    /// margin up to `margin`). `false` promises that no point of the box has one, so
+    /// margin up to `margin`), or a segment within the box a [`Collider::crossing`].
+    /// `false` promises that no point of the box has one and no such segment crosses, so
     /// callers may skip asking for every particle in it; the default never promises.
     /// Shapes that answer must do so in the same arithmetic as their contact tests, so that
     /// the promise holds to the last bit, and must answer `true` for a box with NaN bounds.

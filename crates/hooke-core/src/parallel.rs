@@ -39,22 +39,30 @@ pub(crate) fn for_blocks(
     }
 }
 
-/// [`for_blocks`] with a third per-particle array of any type (start positions, contact
-/// flags), for updates that write three arrays in one pass.
-pub(crate) fn for_blocks3<C: Send>(
+/// [`for_blocks`] with a third and a fourth per-particle array of any types (contact
+/// flags, per-particle records), for updates that write four arrays in one pass.
+pub(crate) fn for_blocks4<C: Send, D: Send>(
     block: usize,
     a: &mut [Vec3],
     b: &mut [Vec3],
     c: &mut [C],
-    f: impl Fn(usize, &mut [Vec3], &mut [Vec3], &mut [C]) + Sync + Send,
+    d: &mut [D],
+    f: impl Fn(usize, &mut [Vec3], &mut [Vec3], &mut [C], &mut [D]) + Sync + Send,
 ) {
-    all_blocks3(block, a, b, c, |start, a, b, c| {
-        f(start, a, b, c);
-        true
-    });
+    if a.len() <= block {
+        f(0, a, b, c, d);
+    } else {
+        a.par_chunks_mut(block)
+            .zip(b.par_chunks_mut(block))
+            .zip(c.par_chunks_mut(block))
+            .zip(d.par_chunks_mut(block))
+            .enumerate()
+            .for_each(|(k, (((a, b), c), d))| f(k * block, a, b, c, d));
+    }
 }
 
-/// [`for_blocks3`] where `f` also reports something about its block: whether every block
+/// [`for_blocks`] with a third per-particle array of any type, where `f` also reports
+/// something about its block: whether every block
 /// reported `true`. Every block runs, whatever the others report.
 pub(crate) fn all_blocks3<C: Send>(
     block: usize,

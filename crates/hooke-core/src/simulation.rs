@@ -134,12 +134,14 @@ impl Simulation {
         &self.workspace
     }
 
-    /// Makes the contact phase test every candidate pair at every step instead of skipping
-    /// those whose displacement bound shows they cannot be within their thickness. The
-    /// results are the same bits either way; this exists so that tests can show it.
+    /// Makes the contact phase test every candidate pair, and every particle against every
+    /// collider, at every step instead of skipping what displacement bounds show cannot
+    /// touch. The results are the same bits either way; this exists so that tests can show
+    /// it.
     #[doc(hidden)]
     pub fn set_exhaustive_contacts(&mut self, exhaustive: bool) {
         self.contacts.exhaustive = exhaustive;
+        self.contacts.face.clear();
     }
 
     /// Figures of the contact phase: its wall time so far, candidate rebuilds, proximities.

@@ -7,7 +7,7 @@
 //!
 //! 1. **Faces.** Every particle is tested against every collider with its body's thickness
 //!    as margin and put `h` out of the surface by the collider's response (restitution,
-//!    stick); see [`crate::Model::resolve_contacts`].
+//!    stick); see `Model::resolve_contacts`.
 //! 2. **Proximities.** Collider features (mesh edges at an angle, the cylinder's rims)
 //!    nearer than `h` to a surface triangle, and particle–triangle and edge–edge pairs of
 //!    surfaces nearer than `h` (self-collision within a body, and between bodies), each give
@@ -36,7 +36,7 @@ mod grid;
 pub mod proximity;
 
 use crate::collider::Feature;
-use crate::model::Model;
+use crate::model::{FaceSkip, Model};
 use crate::particles::{Particles, Vec3};
 use crate::response::Response;
 use grid::Grid;
@@ -210,9 +210,11 @@ pub(crate) struct ContactState {
     x_last: Vec<Vec3>,
     /// The lists were rebuilt since the last detection: travel starts there.
     fresh: bool,
-    /// Test every candidate at every detection, budgets or not (for tests that the
-    /// skipping changes nothing).
+    /// Test every candidate at every detection, budgets or not, and every particle against
+    /// every collider (for tests that the skipping changes nothing).
     pub(crate) exhaustive: bool,
+    /// Per particle: which collider checks can be skipped (see [`FaceSkip`]).
+    pub(crate) face: Vec<FaceSkip>,
     feature_pairs: Vec<FeaturePair>,
     /// Boxes and grids at the last build.
     bins: Bins,
@@ -867,7 +869,24 @@ pub(crate) fn resolve(
         state.prepare(model, p.len());
     }
     let held = &mut state.held;
-    let moved = model.resolve_contacts(&p.inv_mass, &state.margin, x0, &mut p.x, &mut p.v, held);
+    if state.face.len() != p.len() {
+        let skip = if state.exhaustive {
+            FaceSkip::NEVER
+        } else {
+            FaceSkip::default()
+        };
+        state.face = vec![skip; p.len()];
+    }
+    let face = &mut state.face;
+    let moved = model.resolve_contacts(
+        &p.inv_mass,
+        &state.margin,
+        x0,
+        &mut p.x,
+        &mut p.v,
+        held,
+        face,
+    );
     if state.points.is_empty() {
         state.stats.seconds += started.elapsed().as_secs_f64();
         return moved;
@@ -901,7 +920,8 @@ pub(crate) fn resolve(
             let i = i as usize;
             let (x, v) = (&mut p.x[i], &mut p.v[i]);
             let held = &mut state.held[i];
-            *held = model.resolve_particle(p.inv_mass[i], state.margin[i], &x0[i], x, v, *held);
+            *held =
+                model.resolve_particle(p.inv_mass[i], state.margin[i], &x0[i], x, v, *held, None);
         }
     }
     state.moved.clear();
