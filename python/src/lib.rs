@@ -35,7 +35,7 @@ create_exception!(
 
 /// The command line's option names in the library's messages, as the Python arguments
 /// that carry the same values.
-const ARGUMENT_NAMES: [(&str, &str); 10] = [
+const ARGUMENT_NAMES: [(&str, &str); 9] = [
     ("--format ply", "format=\"ply\""),
     ("--format obj", "format=\"obj\""),
     ("--format", "format"),
@@ -43,7 +43,6 @@ const ARGUMENT_NAMES: [(&str, &str); 10] = [
     ("--export", "export path"),
     ("--body", "body"),
     ("--table", "table"),
-    ("--threads", "threads"),
     ("--dt", "dt"),
     ("--duration", "duration"),
 ];
@@ -400,10 +399,7 @@ impl Simulation {
         };
         let target = Target::new(Path::new(path), format, body).map_err(error)?;
         // No export replaces a file the simulation was built from.
-        let mut claims = hooke_cli::output::claims::Claims::default();
-        for (what, file) in &self.inputs {
-            claims.input(what.clone(), file);
-        }
+        let mut claims = hooke_cli::output::claims::Claims::with_inputs(self.inputs.clone());
         target.claim(&mut claims);
         claims.check().map_err(error)?;
         let mut inner = self.lock()?;

@@ -206,13 +206,13 @@ fn main() -> ExitCode {
     // waiting inside another would spin on a core the measured one needs).
     let result = match cli.command {
         Command::View(_) | Command::Bench(_) => dispatch(cli.command),
-        command => match hooke_cli::threads::from_environment() {
-            Err(e) => Err(e),
-            Ok(_) => match hooke_cli::threads::pool(None, "--threads") {
+        // A bad RAYON_NUM_THREADS is refused; a pool that cannot start leaves the work here.
+        command => hooke_cli::threads::count(None, "--threads").and_then(|count| {
+            match hooke_cli::threads::build(count) {
                 Ok(pool) => pool.install(|| dispatch(command)),
                 Err(_) => dispatch(command),
-            },
-        },
+            }
+        }),
     };
     match result {
         Ok(code) => code,

@@ -25,10 +25,7 @@ pub fn render(args: &RenderArgs) -> Result<ExitCode> {
         &args.scene,
         &args.setup.overrides()?,
     )?;
-    let mut claims = hooke_cli::output::claims::Claims::default();
-    for (what, path) in source.inputs() {
-        claims.input(what, &path);
-    }
+    let mut claims = hooke_cli::output::claims::Claims::with_inputs(source.inputs());
     claims.file("-o", &args.output);
     claims.check()?;
     let mut scene = source::build_prepared(source, &args.scene)?;

@@ -177,10 +177,7 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
     };
     let source = source::prepare(source::read(&args.scene)?, &args.scene, &overrides)?;
     // No output may replace an input or another output.
-    let mut claims = Claims::default();
-    for (what, path) in source.inputs() {
-        claims.input(what, &path);
-    }
+    let mut claims = Claims::with_inputs(source.inputs());
     if let Some(path) = &args.trajectory {
         claims.file("--trajectory", path);
     }
@@ -378,7 +375,7 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
 }
 
 pub fn convert(input: &Path, output: &Path) -> Result<ExitCode> {
-    check_output_file(output, "convert", &["toml", "w"])?;
+    let streamed = check_output_file(output, "convert", &["toml", "w"])?.is_stream();
     let mut claims = Claims::default();
     claims.input("the file converted", input);
     claims.file("convert", output);
@@ -390,7 +387,6 @@ pub fn convert(input: &Path, output: &Path) -> Result<ExitCode> {
             .to_string()
     };
     // A stream (`-`, a device, a FIFO) takes the other format than the input's.
-    let streamed = hooke_cli::output::destination::destination(output, "convert")?.is_stream();
     let to = match (streamed, ext(input).as_str()) {
         (true, "w") => "toml".to_string(),
         (true, "toml") => "w".to_string(),

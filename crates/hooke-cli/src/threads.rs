@@ -53,16 +53,26 @@ pub fn from_environment() -> Result<Option<usize>> {
     }
 }
 
-/// A pool of `threads` workers (given as `name`), or of the environment's or one per core
-/// when `None`; refused beyond [`max_threads`].
-pub fn pool(threads: Option<usize>, name: &str) -> Result<rayon::ThreadPool> {
-    let count = match threads {
-        Some(n) => Some(checked(n, name)?),
-        None => from_environment()?,
-    };
+/// The workers a pool gets: `threads` (given as `name`), or the environment's, checked
+/// like [`checked`]; `None`: one per core.
+pub fn count(threads: Option<usize>, name: &str) -> Result<Option<usize>> {
+    match threads {
+        Some(n) => checked(n, name).map(Some),
+        None => from_environment(),
+    }
+}
+
+/// A pool of `count` workers (`None`: one per core), as [`count`] gives.
+pub fn build(count: Option<usize>) -> Result<rayon::ThreadPool> {
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(n) = count {
         builder = builder.num_threads(n);
     }
     builder.build().context("cannot start the worker threads")
+}
+
+/// A pool of `threads` workers (given as `name`), or of the environment's or one per core
+/// when `None`; refused beyond [`max_threads`].
+pub fn pool(threads: Option<usize>, name: &str) -> Result<rayon::ThreadPool> {
+    build(count(threads, name)?)
 }

@@ -112,8 +112,7 @@ impl Target {
                 Target::Usd(path.to_path_buf())
             }
             (false, "pc2", None) => {
-                check_output_file(path, "--export", &["pc2"])?;
-                if crate::output::destination::destination(path, "--export")?.is_stream() {
+                if check_output_file(path, "--export", &["pc2"])?.is_stream() {
                     bail!(
                         "--export {}: a point cache is written with its sample count at the \
                          start, known only at the end: it needs a regular file, not a stream",
@@ -137,9 +136,7 @@ impl Target {
         }
         Ok(target)
     }
-}
 
-impl Target {
     /// Adds the files and folders this export writes to `claims`.
     pub fn claim(&self, claims: &mut crate::output::claims::Claims) {
         match self {

@@ -115,12 +115,11 @@ impl UsdExport {
             taken.push(prim.clone());
             // Hidden temporary files beside the stage (or in the system's temporary folder
             // for a stream), so that no file of another name is written beside it.
-            let scratch = |_: &str| OutputFile::scratch(path);
             bodies.push(BodyStream {
                 opening: opening(&prim, body)?,
-                points: scratch("points")?,
-                velocities: scratch("velocities")?,
-                extent: scratch("extent")?,
+                points: OutputFile::scratch(path)?,
+                velocities: OutputFile::scratch(path)?,
+                extent: OutputFile::scratch(path)?,
             });
         }
         Ok(Self {

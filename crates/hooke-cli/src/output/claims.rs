@@ -83,7 +83,7 @@ pub struct Claims {
     outputs: Vec<Output>,
 }
 
-/// Whether `id` is the null device, which any number of outputs may share.
+/// Whether `path` is the null device, which any number of outputs may share.
 fn is_null(path: &Path) -> bool {
     matches!(
         (std::fs::metadata(path), std::fs::metadata("/dev/null")),
@@ -92,6 +92,15 @@ fn is_null(path: &Path) -> bool {
 }
 
 impl Claims {
+    /// Claims starting from the files a command reads, each with what to call it in a
+    /// message (as [`crate::source::Source::inputs`] gives them).
+    pub fn with_inputs(inputs: impl IntoIterator<Item = (String, PathBuf)>) -> Self {
+        Self {
+            inputs: inputs.into_iter().collect(),
+            outputs: Vec::new(),
+        }
+    }
+
     /// A file the command reads: `what` names it in messages (`the scene file`).
     pub fn input(&mut self, what: impl Into<String>, path: &Path) {
         self.inputs.push((what.into(), path.to_path_buf()));
@@ -135,13 +144,14 @@ impl Claims {
             .iter()
             .map(|(what, p)| (what.as_str(), p.as_path(), id(p)))
             .collect();
+        let ids: Vec<Id> = self.outputs.iter().map(|o| id(&o.path)).collect();
         for (k, out) in self.outputs.iter().enumerate() {
             let shown = out.path.display();
             match &out.kind {
                 Kind::File => {
-                    let me = id(&out.path);
+                    let me = &ids[k];
                     for (what, path, input) in &inputs {
-                        if *input == me {
+                        if input == me {
                             bail!(
                                 "{} {shown}: is {what} {}, which this run reads; refusing to \
                                  overwrite it, choose another name",
@@ -150,12 +160,10 @@ impl Claims {
                             );
                         }
                     }
-                    for other in &self.outputs[..k] {
-                        if matches!(other.kind, Kind::File)
-                            && id(&other.path) == me
-                            && !is_null(&out.path)
+                    for (other, other_id) in self.outputs[..k].iter().zip(&ids) {
+                        if matches!(other.kind, Kind::File) && other_id == me && !is_null(&out.path)
                         {
-                            if me == Id::Stdout {
+                            if *me == Id::Stdout {
                                 bail!(
                                     "{} and {} both write to standard output: give one of them \
                                      a file",
@@ -174,9 +182,9 @@ impl Claims {
                     }
                 }
                 Kind::Frames(ext) => {
-                    let dir = id(&out.path);
+                    let dir = &ids[k];
                     for (what, path, _) in &inputs {
-                        if in_frames(path, &dir, ext) {
+                        if in_frames(path, dir, ext) {
                             bail!(
                                 "{} {shown}: holds {what} {}, named like the frames this run \
                                  removes and writes; move it or choose another folder",
@@ -185,10 +193,11 @@ impl Claims {
                             );
                         }
                     }
-                    for other in self.outputs.iter().filter(|o| !std::ptr::eq(*o, out)) {
+                    let others = self.outputs.iter().zip(&ids).enumerate();
+                    for (_, (other, other_id)) in others.filter(|(j, _)| *j != k) {
                         let clash = match &other.kind {
-                            Kind::File => in_frames(&other.path, &dir, ext),
-                            Kind::Frames(e) => e == ext && id(&other.path) == dir,
+                            Kind::File => in_frames(&other.path, dir, ext),
+                            Kind::Frames(e) => e == ext && other_id == dir,
                         };
                         if clash {
                             bail!(
@@ -204,20 +213,6 @@ impl Claims {
             }
         }
         Ok(())
-    }
-
-    /// The folders of frames claimed, each once (for [`super::lock::FolderLock`]).
-    pub fn frame_folders(&self) -> Vec<(&str, &Path)> {
-        let mut seen: Vec<(Id, &str, &Path)> = Vec::new();
-        for out in &self.outputs {
-            if let Kind::Frames(_) = out.kind {
-                let me = id(&out.path);
-                if !seen.iter().any(|(i, _, _)| *i == me) {
-                    seen.push((me, &out.flag, &out.path));
-                }
-            }
-        }
-        seen.into_iter().map(|(_, f, p)| (f, p)).collect()
     }
 }
 
@@ -318,7 +313,6 @@ mod tests {
         c.frames("--frames", &dir.join("f"), "png");
         c.frames("--export", &dir.join("f/"), "ply");
         c.check().unwrap();
-        assert_eq!(c.frame_folders().len(), 1);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -21,7 +21,7 @@ use std::path::Path;
 /// one of `extensions` (lower case, without the dot; empty: any): `-` (standard output), a
 /// character device or a FIFO, which are written straight through whatever their names;
 /// or a file name, not a folder, in an existing folder that takes a new file, with a
-/// matching extension.
+/// matching extension. Returns what the path is.
 ///
 /// ```
 /// # let dir = std::env::temp_dir();
@@ -30,9 +30,10 @@ use std::path::Path;
 /// assert!(hooke_cli::output::check_output_file(&dir.join("a.png"), "-o", &["png"]).is_ok());
 /// assert!(hooke_cli::output::check_output_file("/dev/null".as_ref(), "-o", &["png"]).is_ok());
 /// ```
-pub fn check_output_file(path: &Path, flag: &str, extensions: &[&str]) -> Result<()> {
-    let Destination::File { target } = destination(path, flag)? else {
-        return Ok(());
+pub fn check_output_file(path: &Path, flag: &str, extensions: &[&str]) -> Result<Destination> {
+    let found = destination(path, flag)?;
+    let Destination::File { target } = &found else {
+        return Ok(found);
     };
     if !extensions.is_empty() {
         let ext = path
@@ -54,7 +55,7 @@ pub fn check_output_file(path: &Path, flag: &str, extensions: &[&str]) -> Result
         }
     }
     // A probe: the folder takes a new file now, not only in principle.
-    let dir = destination::folder(&target);
+    let dir = destination::folder(target);
     let probe = file::temp_in(dir);
     File::create(&probe).with_context(|| {
         format!(
@@ -64,7 +65,7 @@ pub fn check_output_file(path: &Path, flag: &str, extensions: &[&str]) -> Result
         )
     })?;
     let _ = std::fs::remove_file(&probe);
-    Ok(())
+    Ok(found)
 }
 
 /// Checks, before a run, that `dir` (given with option `flag`) can be an output folder: it
