@@ -1,5 +1,6 @@
 //! The analytic cylinder tabletop of the course document.
 
+use crate::bounds::{boxes_meet, touch_reach};
 use hooke_core::{Circle, Collider, Contact, Feature, Vec3};
 
 /// A solid vertical disc: top face at `y = Y`, bottom at `Y - thickness`, radius `R` about
@@ -125,10 +126,7 @@ impl Collider for Cylinder {
             Vec3::new(c.x - self.radius, c.y - self.thickness, c.z - self.radius),
             Vec3::new(c.x + self.radius, c.y, c.z + self.radius),
         );
-        let grow = |v: &Vec3| margin + 1e-9 + 1e-9 * v.amax();
-        let (glo, ghi) = (grow(lo), grow(hi));
-        // Written so that NaN answers `true`.
-        !(0..3).any(|k| lo[k] - glo > b[k] || hi[k] + ghi < a[k])
+        boxes_meet(lo, hi, &a, &b, touch_reach(lo, hi, margin))
     }
 
     /// Inside: the nearest face, `margin` further out. Outside: the nearest point of the

@@ -26,6 +26,7 @@
 
 #![forbid(unsafe_code)]
 
+mod bounds;
 mod box_interior;
 mod cylinder;
 mod obj;

@@ -1,6 +1,7 @@
 //! Triangle-mesh colliders on parry3d-f64: closed parts answer inside tests, every part
 //! answers the crossing test so that a thin tabletop cannot be tunnelled through.
 
+use crate::bounds::{boxes_meet, touch_reach};
 use crate::obj::{MeshError, MeshPart};
 use hooke_core::{Collider, Contact, Feature, Vec3};
 use parry3d_f64::bounding_volume::Aabb;
@@ -225,11 +226,6 @@ impl TriMeshCollider {
         })
     }
 
-    /// Number of triangles with an area, over all parts.
-    pub fn triangle_count(&self) -> usize {
-        self.parts.iter().map(|p| p.mesh.indices().len()).sum()
-    }
-
     /// Number of parts (objects).
     pub fn part_count(&self) -> usize {
         self.parts.len()
@@ -306,6 +302,14 @@ fn feature_edges(mesh: &ParryMesh, closed: bool) -> Vec<u8> {
     mask
 }
 
+impl Part {
+    /// Whether the box `lo..hi`, grown by `grow`, meets the part's bounds.
+    fn meets(&self, lo: &Vec3, hi: &Vec3, grow: f64) -> bool {
+        let (a, b) = (from_parry(self.aabb.mins), from_parry(self.aabb.maxs));
+        boxes_meet(lo, hi, &a, &b, grow)
+    }
+}
+
 fn in_aabb(aabb: &Aabb, p: &Vec3) -> bool {
     in_aabb_within(aabb, p, 0.0)
 }
@@ -367,13 +371,8 @@ impl Collider for TriMeshCollider {
     /// Whether the box, grown by `margin` (and a little for rounding), meets the bounds of
     /// some part: every contact and crossing lies within a part's bounds.
     fn may_touch(&self, lo: &Vec3, hi: &Vec3, margin: f64) -> bool {
-        let grow = |v: &Vec3| margin + 1e-9 + 1e-9 * v.amax();
-        let (glo, ghi) = (grow(lo), grow(hi));
-        // Written so that NaN answers `true`.
-        self.parts.iter().any(|part| {
-            let (a, b) = (part.aabb.mins, part.aabb.maxs);
-            !(0..3).any(|k| lo[k] - glo > b[k] || hi[k] + ghi < a[k])
-        })
+        let grow = touch_reach(lo, hi, margin);
+        self.parts.iter().any(|part| part.meets(lo, hi, grow))
     }
 
     fn contacts_within(&self, p: &Vec3, margin: f64, sink: &mut dyn FnMut(Contact)) {
@@ -423,8 +422,7 @@ impl Collider for TriMeshCollider {
     fn features(&self, lo: &Vec3, hi: &Vec3, sink: &mut dyn FnMut(Feature)) {
         let query = Aabb::new(to_parry(lo), to_parry(hi));
         for part in &self.parts {
-            let (a, b) = (part.aabb.mins, part.aabb.maxs);
-            if hi.x < a.x || lo.x > b.x || hi.y < a.y || lo.y > b.y || hi.z < a.z || lo.z > b.z {
+            if !part.meets(lo, hi, 0.0) {
                 continue;
             }
             let v = part.mesh.vertices();
@@ -463,8 +461,7 @@ impl Collider for TriMeshCollider {
         let ray = Ray::new(to_parry(from), to_parry(&dir));
         let mut best: Option<(f64, Vec3)> = None;
         for part in &self.parts {
-            let (a, b) = (part.aabb.mins, part.aabb.maxs);
-            if hi.x < a.x || lo.x > b.x || hi.y < a.y || lo.y > b.y || hi.z < a.z || lo.z > b.z {
+            if !part.meets(&lo, &hi, 0.0) {
                 continue;
             }
             let Some(hit) = part.mesh.cast_local_ray_and_get_normal(&ray, 1.0, false) else {
