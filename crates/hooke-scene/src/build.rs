@@ -452,6 +452,16 @@ fn body_aero(
 
 /// The contact surface of a body: its triangles with the thickness, self-collision and
 /// friction its spec gives or the defaults for its shape.
+/// The contact thickness a body with a surface gets when its spec gives none: for a grid
+/// the cloth default, at most a quarter of the spacing so that a fine cloth's neighbours
+/// never touch; none for other shapes.
+fn default_thickness(shape: &ShapeSpec) -> f64 {
+    match shape {
+        ShapeSpec::Grid { spacing, .. } => DEFAULT_CLOTH_THICKNESS.min(0.25 * spacing.get()),
+        _ => 0.0,
+    }
+}
+
 fn body_surface(
     body: &BodySpec,
     key: &str,
@@ -459,14 +469,13 @@ fn body_surface(
     particles: Range<usize>,
     triangles: Vec<[u32; 3]>,
 ) -> Result<Surface, BuildError> {
-    let default = match body.shape {
-        // A quarter of the spacing at most, so a fine cloth's neighbours never touch.
-        ShapeSpec::Grid { spacing, .. } => DEFAULT_CLOTH_THICKNESS.min(0.25 * spacing.get()),
-        _ => 0.0,
-    };
     // A body without triangles (a chain, points, a grid one particle wide) has no surface:
     // its default thickness is none, and contact keys written for it are refused by name.
-    let default = if triangles.is_empty() { 0.0 } else { default };
+    let default = if triangles.is_empty() {
+        0.0
+    } else {
+        default_thickness(&body.shape)
+    };
     let thickness = body.thickness.map_or(default, |h| h.get());
     if triangles.is_empty() {
         let written = [
@@ -645,13 +654,15 @@ impl SceneSpec {
             // A grid has triangles when it is two particles wide both ways, a lattice when
             // two of its sides are (crate::surface::triangles), without making them.
             let wide = |sides: &[usize]| sides.iter().filter(|&&n| n >= 2).count();
-            let thickness = match &body.shape {
-                ShapeSpec::Grid { size, spacing } if wide(size) == 2 => {
-                    DEFAULT_CLOTH_THICKNESS.min(0.25 * spacing.get())
-                }
-                ShapeSpec::Lattice { size, .. } if wide(size) >= 2 => 0.0,
-                _ => continue,
+            let surface = match &body.shape {
+                ShapeSpec::Grid { size, .. } => wide(size) == 2,
+                ShapeSpec::Lattice { size, .. } => wide(size) >= 2,
+                _ => false,
             };
+            if !surface {
+                continue;
+            }
+            let thickness = default_thickness(&body.shape);
             body.thickness.get_or_insert(NonNegative::of(thickness));
             body.self_collision.get_or_insert(true);
             body.friction
