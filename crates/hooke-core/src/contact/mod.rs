@@ -480,9 +480,9 @@ impl ContactState {
             *budget - moved
         };
         let travel = &self.travel;
-        let climb = self.climb;
-        let skip = !self.exhaustive;
-        let climb = skip.then_some(climb);
+        // Exhaustive: no climb, so no block is skipped, and no pair either.
+        let climb = (!self.exhaustive).then_some(self.climb);
+        let skip = climb.is_some();
         let mut budgets = std::mem::take(&mut self.point_tri_budget);
         budgets.run(&mut scratch, climb, |i, budget, out| {
             let [p, t] = self.point_tri[i];
