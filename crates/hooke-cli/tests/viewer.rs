@@ -55,7 +55,8 @@ fn open_viewer(display: &str, args: &[&str]) -> (Reaper, String) {
                 .spawn()
                 .unwrap(),
         );
-        let window = until(Duration::from_secs(30), || {
+        // Minutes, not seconds: a loaded machine is slow to start a process, not wrong.
+        let window = until(Duration::from_secs(120), || {
             if viewer.0.try_wait().ok().flatten().is_some() {
                 return Some(None);
             }
@@ -228,9 +229,9 @@ fn viewer_animates_tab_switches_scenes_and_w_stills_the_wind_under_xvfb() {
                     .expect("start Xvfb"),
             );
             let socket = PathBuf::from(format!("/tmp/.X11-unix/X{number}"));
-            until(Duration::from_secs(10), || socket.exists().then_some(()))?;
+            until(Duration::from_secs(60), || socket.exists().then_some(()))?;
             // The socket appears before the server takes clients: wait for an answer.
-            until(Duration::from_secs(10), || {
+            until(Duration::from_secs(60), || {
                 xdotool(&display, &["getdisplaygeometry"]).filter(|g| !g.is_empty())
             })?;
             x.0.try_wait()
@@ -348,7 +349,7 @@ fn viewer_animates_tab_switches_scenes_and_w_stills_the_wind_under_xvfb() {
         .status()
         .unwrap();
     assert!(sent.success());
-    let status = until(Duration::from_secs(10), || {
+    let status = until(Duration::from_secs(120), || {
         viewer.0.try_wait().ok().flatten()
     })
     .expect("the viewer did not close on Ctrl-C");
