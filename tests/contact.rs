@@ -49,8 +49,8 @@ fn overlap(a: &(Vec3, Vec3), b: &(Vec3, Vec3)) -> bool {
 }
 
 /// One exported frame: the cloth triangles with their corner indices, and the colliders'.
-struct Frame {
-    cloth: Vec<(Tri, [u32; 3])>,
+pub(crate) struct Frame {
+    pub(crate) cloth: Vec<(Tri, [u32; 3])>,
     colliders: Vec<Tri>,
 }
 
@@ -85,7 +85,7 @@ fn read_frame(path: &Path) -> Frame {
 }
 
 /// Crossings in one frame: (cloth–collider, cloth–cloth) pair counts.
-fn crossings(frame: &Frame) -> (usize, usize) {
+pub(crate) fn crossings(frame: &Frame) -> (usize, usize) {
     let cloth_boxes: Vec<_> = frame.cloth.iter().map(|(t, _)| bounds(t)).collect();
     let mut against_colliders = 0;
     for c in &frame.colliders {
@@ -118,16 +118,17 @@ fn crossings(frame: &Frame) -> (usize, usize) {
     (against_colliders, among_cloth)
 }
 
-/// Runs built-in `name` to its end, exporting every frame into a fresh folder.
-fn export_run(name: &str, table: Option<&str>) -> (PathBuf, u64) {
-    let overrides = Overrides {
-        table: table.map(|t| t.parse().unwrap()),
-        ..Overrides::default()
-    };
-    let mut scene = builtin(name, &overrides);
+/// Runs built-in `name` with `overrides` to its end, exporting every frame into a fresh
+/// folder named with `tag`.
+fn export_run(name: &str, overrides: &Overrides, tag: &str) -> (PathBuf, u64) {
+    export_scene(builtin(name, overrides), &format!("{name}-{tag}"))
+}
+
+/// Runs `scene` to its end, exporting every frame into a fresh folder named with `tag`.
+fn export_scene(mut scene: hooke_scene::Scene, tag: &str) -> (PathBuf, u64) {
     let dir = std::env::temp_dir().join(format!(
-        "hooke-contact-{name}-{}-{}",
-        table.map_or("default".into(), |t| t.replace(['/', '.'], "_")),
+        "hooke-contact-{}-{}",
+        tag.replace(['/', '.'], "_"),
         std::process::id()
     ));
     let _ = std::fs::remove_dir_all(&dir);
@@ -143,7 +144,29 @@ fn export_run(name: &str, table: Option<&str>) -> (PathBuf, u64) {
 }
 
 fn assert_no_crossings(name: &str, table: Option<&str>) {
-    let (dir, frames) = export_run(name, table);
+    let overrides = Overrides {
+        table: table.map(|t| t.parse().unwrap()),
+        ..Overrides::default()
+    };
+    assert_no_crossings_with(name, &overrides, table.unwrap_or("default"));
+}
+
+/// [`assert_no_crossings`] for built-in `name` under `overrides`; returns the last frame.
+pub(crate) fn assert_no_crossings_with(name: &str, overrides: &Overrides, tag: &str) -> Frame {
+    let (dir, frames) = export_run(name, overrides, tag);
+    frames_never_cross(&dir, frames, &format!("{name} {tag}"))
+}
+
+/// [`assert_no_crossings`] for a built scene; returns the last frame.
+pub(crate) fn assert_scene_never_crosses(scene: hooke_scene::Scene, tag: &str) -> Frame {
+    let (dir, frames) = export_scene(scene, tag);
+    frames_never_cross(&dir, frames, tag)
+}
+
+/// Reads frames `0..=frames` of `dir`, asserts none crosses, removes `dir` and returns the
+/// last frame.
+fn frames_never_cross(dir: &Path, frames: u64, what: &str) -> Frame {
+    let mut last = None;
     let mut bad = Vec::new();
     for f in 0..=frames {
         let frame = read_frame(&dir.join(format!("frame-{f:05}.obj")));
@@ -154,15 +177,17 @@ fn assert_no_crossings(name: &str, table: Option<&str>) {
                 "frame {f}: {c} cloth-collider, {s} cloth-cloth crossings"
             ));
         }
+        last = Some(frame);
     }
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
     assert!(
         bad.is_empty(),
-        "{name} {table:?}: {} of {} frames cross:\n{}",
+        "{what}: {} of {} frames cross:\n{}",
         bad.len(),
         frames + 1,
         bad.join("\n")
     );
+    last.unwrap()
 }
 
 #[test]

@@ -10,6 +10,7 @@ mod conservation;
 mod contact;
 mod determinism;
 mod images;
+mod large_steps;
 mod oscillator;
 mod roundtrip;
 mod scenes;

@@ -49,11 +49,15 @@ def cli_trajectory(tmp_path, *args):
     ("cloth-table", 1200, 40),            # contacts: sticking to the mesh table
     ("assets/worlds/rotate.w", 300, 10),  # rk4, force field, penalty colliders
     ("flag", 800, 40),                    # air
+    ("cloth-pile", 30, 5),                # block descent at a 60 Hz frame (with --dt below)
 ])
 def test_a_trajectory_stepped_from_python_is_the_commands_bit_for_bit(tmp_path, source, steps, every):
     path = str(ROOT / source) if source.endswith(".w") else source
-    frames = cli_trajectory(tmp_path, path, "--steps", str(steps), "--every", str(every))
-    sim = hooke.load(path, steps=steps, every=every)
+    large = {"integrator": "vbd", "dt": 1 / 60} if source == "cloth-pile" else {}
+    flags = [a for k, v in large.items() for a in (f"--{k}", repr(v))]
+    frames = cli_trajectory(tmp_path, path, "--steps", str(steps), "--every", str(every), *flags)
+    sim = hooke.load(path, steps=steps, every=every, **large)
+    assert sim.integrator == large.get("integrator", sim.integrator)
     for k, expected in enumerate(frames):
         if k > 0:
             sim.step(every)

@@ -222,6 +222,11 @@ struct SceneFigures {
     dt: f64,
     /// Average conjugate-gradient iterations per step (implicit only).
     cg_iterations_per_step: f64,
+    /// Average block-descent iterations and contact detections per step (vbd only).
+    vbd_iterations_per_step: f64,
+    vbd_detections_per_step: f64,
+    /// Wall seconds per simulated second.
+    wall_per_simulated_s: f64,
     integrator: String,
     kernel: String,
     particles: usize,
@@ -463,13 +468,19 @@ fn scene_steps(
     use_kernel(sim, kernel)?;
     sim.advance(steps.min(100))?;
     let mut cg_iterations = 0;
+    let (mut vbd_iterations, mut vbd_detections) = (0, 0);
     let contacts_before = sim.contact_stats();
     let (times, seconds) = StepTimes::run(sim, steps, |sim| {
         cg_iterations += sim.workspace().cg_iterations();
+        vbd_iterations += sim.workspace().vbd_iterations();
+        vbd_detections += sim.workspace().vbd_detections();
     })?;
     let contacts = sim.contact_stats();
     let figures = SceneFigures {
         cg_iterations_per_step: cg_iterations as f64 / steps as f64,
+        vbd_iterations_per_step: vbd_iterations as f64 / steps as f64,
+        vbd_detections_per_step: vbd_detections as f64 / steps as f64,
+        wall_per_simulated_s: seconds / (steps as f64 * sim.dt()),
         dt: sim.dt(),
         scene: scene.spec.name.clone(),
         integrator: sim.integrator().to_string(),
@@ -512,6 +523,11 @@ fn scene_steps(
                 format!(
                     ", {:.1} CG iterations per step",
                     figures.cg_iterations_per_step
+                )
+            } else if vbd_iterations > 0 {
+                format!(
+                    ", {:.1} block-descent iterations and {:.1} detections per step",
+                    figures.vbd_iterations_per_step, figures.vbd_detections_per_step
                 )
             } else {
                 String::new()

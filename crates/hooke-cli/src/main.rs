@@ -71,7 +71,8 @@ enum Command {
 /// Options that change what is simulated.
 #[derive(Args, Clone, Default)]
 struct SetupArgs {
-    /// Integrator: euler, symplectic, midpoint, rk4 or implicit.
+    /// Integrator: euler, symplectic, midpoint, rk4, implicit or vbd (block descent: one
+    /// crossing-free implicit step per display frame, docs/physics.md §4.6).
     #[arg(long)]
     integrator: Option<Integrator>,
     /// Step size in seconds.

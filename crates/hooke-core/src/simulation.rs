@@ -250,7 +250,9 @@ impl Simulation {
         );
         self.last = report;
         // Every scheme saves its start positions when the model has a contact phase.
+        // Block descent keeps its contacts inside its own iterations.
         let moved = self.model.has_contact_phase()
+            && self.integrator != Integrator::Vbd
             && contact::resolve(
                 &self.model,
                 &mut self.particles,

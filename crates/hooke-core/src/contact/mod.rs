@@ -32,7 +32,7 @@
 //! detection are split into a fixed number of chunks whose results are read in order:
 //! results are the same bits on any thread count.
 
-mod grid;
+pub(crate) mod grid;
 pub mod proximity;
 
 use crate::collider::Feature;

@@ -1,0 +1,872 @@
+//! Detection for block descent: the contacts each particle's local solve feels, and the
+//! displacement bound that keeps every surface from crossing a collider or another surface
+//! until the next detection (the offset-bound idea of Chen et al. 2025, written for this
+//! model's colliders and surfaces; docs/physics.md §4.6).
+//!
+//! Each particle `v` moves, between two detections, within a ball of radius `b_v` around
+//! `x_v + u` (positions at the detection; `u` a translation shared by every surface
+//! particle, zero for the rest). With `d` the distance of two primitives at the detection:
+//!
+//! * a point and a non-incident triangle, or two edges sharing no particle, of the surfaces:
+//!   both sides share `u`, so the gap changes by at most the two sides' `b`; every `b` of
+//!   either side is at most `γ_s d`, and `2 γ_s < 1` keeps the gap open;
+//! * a particle or a surface triangle and a collider (which does not move): the point moves
+//!   at most `|u| + b ≤ γ_c d` with `γ_c < 1`.
+//!
+//! Distances are searched only up to a reach (`R_s`, `R_c`); a pair farther than the reach
+//! bounds by the reach, which is enough for the same argument. The bound holds whatever the
+//! step size: the integrator can fail to converge, never cross.
+
+use super::graph::Graph;
+use crate::collider::Feature;
+use crate::contact::grid::Grid;
+use crate::contact::proximity::{point_triangle, segment_segment, segment_triangle};
+use crate::model::Model;
+use crate::particles::{Particles, Vec3};
+use crate::response::Response;
+use rayon::prelude::*;
+use std::ops::Range;
+
+/// Share of a surface-to-surface distance each side may use up: below one half.
+pub(crate) const GAMMA_SURFACE: f64 = 0.4;
+/// Share of a distance to a collider a particle may use up: below one.
+pub(crate) const GAMMA_COLLIDER: f64 = 0.9;
+/// Reach of the search between surfaces, in thicknesses.
+const SURFACE_REACH: f64 = 4.0;
+/// Least reach of the search for colliders, in thicknesses.
+const COLLIDER_REACH: f64 = 10.0;
+/// Pairs nearer than this many thicknesses are felt until the next detection; farther ones
+/// bound the motion instead, so that they cannot come within a thickness unfelt.
+const FELT: f64 = 2.0;
+/// Contact stiffness as a multiple of a particle's own stiffness scale `m/dt² + Σ ks`.
+pub(crate) const CONTACT_STIFFNESS: f64 = 1.0;
+/// Particles (or triangles, edges) per parallel chunk of the detection.
+const CHUNK: usize = 512;
+
+/// What a pair's two sides are.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Sides {
+    /// Particle `ids[0]` against triangle `ids[1..4]`, which owns the features marked in
+    /// its mask (see [`Topology::owns`]).
+    PointTriangle(u8),
+    /// Edge `ids[0..2]` against edge `ids[2..4]`.
+    EdgeEdge,
+    /// Triangle `ids[0..3]` against the point of a collider's sharp feature nearest it at
+    /// the detection (the feature's tangent, as [`Plane`] is the faces').
+    Feature(Vec3),
+}
+
+/// A contact between two primitives, felt by the particles in `ids`.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Pair {
+    pub(super) sides: Sides,
+    pub(super) ids: [u32; 4],
+    /// The gap kept, metres.
+    pub(super) h: f64,
+    /// Normal stiffness, N/m.
+    pub(super) k: f64,
+    /// Coulomb coefficient (infinite: stick; zero: none).
+    pub(super) mu: f64,
+}
+
+/// The closest points of a pair at `x`: weights `w` on its particles such that
+/// `Σ w_k x_k - anchor` is the gap vector, and whether the pair is the one that counts
+/// that contact. A point nearest a triangle's edge or corner is as near every triangle
+/// sharing it, and two edges nearest at an end are a point against a triangle: such a
+/// contact counts once (the owning triangle's, the point–triangle pair's), so that a
+/// particle over a fold of a mesh does not feel it six times.
+pub(super) fn stencil(pair: &Pair, x: &[Vec3]) -> ([f64; 4], Vec3, usize, bool) {
+    let p = |k: usize| &x[pair.ids[k] as usize];
+    match pair.sides {
+        Sides::PointTriangle(owns) => {
+            let w = point_triangle(p(0), p(1), p(2), p(3));
+            let zeros = w.iter().filter(|&&w| w == 0.0).count();
+            let counts = match zeros {
+                // An edge: the one opposite the zero weight (bits 0..3: ab, bc, ca).
+                1 => {
+                    let edge = match w.iter().position(|&w| w == 0.0) {
+                        Some(2) => 0,
+                        Some(0) => 1,
+                        _ => 2,
+                    };
+                    owns >> edge & 1 == 1
+                }
+                // A corner (bits 3..6).
+                2 => owns >> (3 + w.iter().position(|&w| w != 0.0).unwrap_or(0)) & 1 == 1,
+                _ => true,
+            };
+            ([1.0, -w[0], -w[1], -w[2]], Vec3::zeros(), 4, counts)
+        }
+        Sides::EdgeEdge => {
+            let (s, t) = segment_segment(p(0), p(1), p(2), p(3));
+            let inside = s > 0.0 && s < 1.0 && t > 0.0 && t < 1.0;
+            ([1.0 - s, s, t - 1.0, -t], Vec3::zeros(), 4, inside)
+        }
+        Sides::Feature(anchor) => {
+            let w = point_triangle(&anchor, p(0), p(1), p(2));
+            ([w[0], w[1], w[2], 0.0], anchor, 3, true)
+        }
+    }
+}
+
+/// The point of feature `f` nearest triangle `abc`, and the triangle's weights of its
+/// point nearest to it.
+fn feature_triangle(f: &Feature, a: &Vec3, b: &Vec3, c: &Vec3) -> (Vec3, [f64; 3]) {
+    match f {
+        Feature::Segment([p, q]) => {
+            let (s, w) = segment_triangle(p, q, a, b, c);
+            (p + (q - p) * s, w)
+        }
+        Feature::Circle(circle) => crate::contact::proximity::circle_triangle(circle, a, b, c),
+    }
+}
+
+/// How near a primitive's nearest neighbour is, and its nearest neighbour whose contact is
+/// not felt (farther than [`FELT`] thicknesses), capped at the search's reach.
+#[derive(Clone, Copy, Debug)]
+struct Clearance {
+    nearest: f64,
+    unfelt: f64,
+}
+
+impl Clearance {
+    fn new(reach: f64) -> Self {
+        Self {
+            nearest: reach,
+            unfelt: reach,
+        }
+    }
+
+    fn see(&mut self, d: f64, felt: bool) {
+        self.nearest = self.nearest.min(d);
+        if !felt {
+            self.unfelt = self.unfelt.min(d);
+        }
+    }
+
+    fn meet(&mut self, other: &Clearance) {
+        self.nearest = self.nearest.min(other.nearest);
+        self.unfelt = self.unfelt.min(other.unfelt);
+    }
+
+    /// The motion this clearance allows one side of its pairs: `gamma` of the nearest
+    /// distance, and no nearer than `h` to the unfelt ones, whose other side moves as much
+    /// (`sides` = 2) or not at all (`sides` = 1, a collider).
+    fn allows(&self, gamma: f64, h: f64, sides: f64) -> f64 {
+        (gamma * self.nearest).min((self.unfelt - h) / sides)
+    }
+}
+
+/// A collider's surface near a particle, as its tangent plane at the last detection: the
+/// iterations measure the particle's gap to it as `normal · (x - point)`, exact for flat
+/// faces and within the bound's reach of exact for curved ones, at the cost of a dot
+/// product instead of a collider query.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Plane {
+    pub(super) collider: u16,
+    pub(super) point: Vec3,
+    pub(super) normal: Vec3,
+}
+
+/// Planes a particle keeps at most (a box's corner and a table's edge need three).
+const TOUCHES: usize = 4;
+
+/// The collider planes one particle may touch, nearest kept when there are more.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Touches {
+    count: u8,
+    planes: [Plane; TOUCHES],
+    gaps: [f64; TOUCHES],
+}
+
+impl Default for Touches {
+    fn default() -> Self {
+        let none = Plane {
+            collider: 0,
+            point: Vec3::zeros(),
+            normal: Vec3::zeros(),
+        };
+        Self {
+            count: 0,
+            planes: [none; TOUCHES],
+            gaps: [f64::INFINITY; TOUCHES],
+        }
+    }
+}
+
+impl Touches {
+    /// The planes.
+    pub(super) fn planes(&self) -> &[Plane] {
+        &self.planes[..self.count as usize]
+    }
+
+    /// Keeps `plane` at gap `d` if there is room or it is nearer than the farthest kept.
+    fn keep(&mut self, plane: Plane, d: f64) {
+        let k = if (self.count as usize) < TOUCHES {
+            self.count += 1;
+            self.count as usize - 1
+        } else {
+            let (far, gap) =
+                self.gaps
+                    .iter()
+                    .enumerate()
+                    .fold(
+                        (0, f64::NEG_INFINITY),
+                        |a, (k, &g)| if g > a.1 { (k, g) } else { a },
+                    );
+            if d >= gap {
+                return;
+            }
+            far
+        };
+        self.planes[k] = plane;
+        self.gaps[k] = d;
+    }
+}
+
+/// The surfaces' primitives, fixed for a model.
+#[derive(Clone, Debug, Default)]
+struct Topology {
+    built_for: usize,
+    /// Active surfaces' triangles and edges, with their surface's index.
+    triangles: Vec<([u32; 3], u16)>,
+    edges: Vec<([u32; 2], u16)>,
+    /// Per particle: its active surface, or `u16::MAX`.
+    surface: Vec<u16>,
+    /// Whether any surface pair (self or between bodies) can touch.
+    self_pairs: bool,
+    /// Per triangle: which of its edges (bits 0..3: ab, bc, ca) and corners (bits 3..6)
+    /// it owns, being the first triangle of its surface to have them.
+    owns: Vec<u8>,
+}
+
+impl Topology {
+    fn new(model: &Model, n: usize) -> Self {
+        let mut t = Self {
+            built_for: n,
+            surface: vec![u16::MAX; n],
+            ..Self::default()
+        };
+        let active: Vec<_> = model
+            .surfaces
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.is_active())
+            .collect();
+        for &(k, s) in &active {
+            for p in s.particles.clone() {
+                t.surface[p] = k as u16;
+            }
+            t.triangles
+                .extend(s.triangles.iter().map(|&tri| (tri, k as u16)));
+            t.edges.extend(s.edges().into_iter().map(|e| (e, k as u16)));
+        }
+        t.self_pairs = active.len() > 1 || active.iter().any(|(_, s)| s.self_collision);
+        let mut edges = std::collections::HashSet::new();
+        let mut corners = vec![false; n];
+        t.owns = t
+            .triangles
+            .iter()
+            .map(|([a, b, c], _)| {
+                let mut mask = 0u8;
+                for (k, (u, v)) in [(a, b), (b, c), (c, a)].into_iter().enumerate() {
+                    if edges.insert((*u.min(v), *u.max(v))) {
+                        mask |= 1 << k;
+                    }
+                }
+                for (k, v) in [a, b, c].into_iter().enumerate() {
+                    if !std::mem::replace(&mut corners[*v as usize], true) {
+                        mask |= 1 << (3 + k);
+                    }
+                }
+                mask
+            })
+            .collect();
+        t
+    }
+}
+
+/// The result of a detection, and its buffers.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Detection {
+    topology: Topology,
+    triangle_grid: Grid,
+    edge_grid: Grid,
+    /// Positions at the first step: pairs nearer than their gap there are neighbours in the
+    /// body's own rest shape, not contacts.
+    rest: Vec<Vec3>,
+    /// Per particle: the collider surfaces it may reach before the next detection, each as
+    /// its tangent plane at the detection.
+    pub(super) touches: Vec<Touches>,
+    /// Surface pairs and feature pairs within reach.
+    pub(super) pairs: Vec<Pair>,
+    /// Particle `i`'s pairs are `refs[start[i]..start[i + 1]]`.
+    start: Vec<u32>,
+    refs: Vec<u32>,
+    /// The counting sort's write positions.
+    cursor: Vec<u32>,
+    /// Per particle: the centre offset (`u` or zero) and radius of the ball it stays in.
+    pub(super) shift: Vec3,
+    pub(super) shifted: Vec<bool>,
+    pub(super) bound: Vec<f64>,
+    /// Per particle, per triangle, per edge: distances found (capped at the reach).
+    point_collider: Vec<Clearance>,
+    triangle_collider: Vec<Clearance>,
+    point_surface: Vec<Clearance>,
+    triangle_surface: Vec<Clearance>,
+    edge_surface: Vec<Clearance>,
+    /// Buffers of the bounds, kept so that a detection allocates nothing on a model
+    /// without surface pairs.
+    scratch_collider: Vec<Clearance>,
+    scratch_own: Vec<Clearance>,
+    scratch_allowed: Vec<f64>,
+    /// Each surface's thickness, and the largest of the active ones.
+    thickness: Vec<f64>,
+    h_max: f64,
+    /// Per particle: its stiffness scale `m/dt² + Σ ks`.
+    pub(super) scale: Vec<f64>,
+}
+
+/// `f` over fixed chunks of `0..n` in parallel, results concatenated in chunk order.
+fn chunked<T: Send>(n: usize, f: impl Fn(Range<usize>) -> Vec<T> + Sync + Send) -> Vec<T> {
+    if n <= CHUNK {
+        return f(0..n);
+    }
+    let parts: Vec<Vec<T>> = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| f(c * CHUNK..((c + 1) * CHUNK).min(n)))
+        .collect();
+    parts.into_iter().flatten().collect()
+}
+
+fn bounds_of(points: &[&Vec3]) -> (Vec3, Vec3) {
+    let mut lo = *points[0];
+    let mut hi = *points[0];
+    for p in &points[1..] {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    (lo, hi)
+}
+
+/// Whether point `p` lies in box `lo..hi` grown by `r`.
+fn within(p: &Vec3, (lo, hi): &(Vec3, Vec3), r: f64) -> bool {
+    (0..3).all(|k| p[k] >= lo[k] - r && p[k] <= hi[k] + r)
+}
+
+fn boxes_within(a: &(Vec3, Vec3), b: &(Vec3, Vec3), r: f64) -> bool {
+    (0..3).all(|k| a.0[k] <= b.1[k] + r && b.0[k] <= a.1[k] + r)
+}
+
+/// Calls `f` for every cell from `lo`'s to `hi`'s.
+fn cells(grid: &Grid, lo: &Vec3, hi: &Vec3, mut f: impl FnMut([i64; 3])) {
+    let (a, b) = (grid.cell_of(lo), grid.cell_of(hi));
+    for i in a[0]..=b[0] {
+        for j in a[1]..=b[1] {
+            for k in a[2]..=b[2] {
+                f([i, j, k]);
+            }
+        }
+    }
+}
+
+/// The normal stiffness and Coulomb coefficient a collider's response gives a contact with
+/// stiffness scale `scale`.
+pub(super) fn collider_law(response: &Response, scale: f64) -> (f64, f64) {
+    match *response {
+        Response::Penalty { kc, .. } => (kc, 0.0),
+        Response::Restitution { friction, .. } => (CONTACT_STIFFNESS * scale, friction),
+        Response::Stick => (CONTACT_STIFFNESS * scale, f64::INFINITY),
+    }
+}
+
+impl Detection {
+    /// Particle `i`'s pairs.
+    #[inline]
+    pub(super) fn pairs_of(&self, i: usize) -> impl Iterator<Item = &Pair> {
+        self.refs[self.start[i] as usize..self.start[i + 1] as usize]
+            .iter()
+            .map(|&k| &self.pairs[k as usize])
+    }
+
+    /// Whether any pair was found.
+    pub(super) fn has_pairs(&self) -> bool {
+        !self.pairs.is_empty()
+    }
+
+    /// Calls `f` with every particle that shares a pair with particle `i`.
+    pub(super) fn partners(&self, i: usize, f: &mut dyn FnMut(u32)) {
+        for pair in self.pairs_of(i) {
+            for &j in &pair.ids {
+                if j != u32::MAX && j as usize != i {
+                    f(j);
+                }
+            }
+        }
+    }
+
+    /// Whether particle `i` may feel a contact before the next detection.
+    #[inline]
+    pub(super) fn may_touch(&self, i: usize) -> bool {
+        self.touches[i].count != 0 || self.start[i] != self.start[i + 1]
+    }
+
+    /// The thickness particle `i` keeps from colliders.
+    #[inline]
+    pub(super) fn margin(&self, model: &Model, i: usize) -> f64 {
+        match self.topology.surface[i] {
+            u16::MAX => 0.0,
+            s => model.surfaces[s as usize].thickness,
+        }
+    }
+
+    /// Detects at positions `x` (the current iterate), with `y` the step's inertial targets
+    /// (which set how far the search reaches and the shared translation `u`).
+    pub(super) fn detect(
+        &mut self,
+        model: &Model,
+        p: &Particles,
+        graph: &Graph,
+        (x, y): (&[Vec3], &[Vec3]),
+        dt: f64,
+    ) {
+        let n = x.len();
+        if self.topology.built_for != n || self.rest.len() != n {
+            self.topology = Topology::new(model, n);
+            self.rest = x.to_vec();
+        }
+        self.scale.clear();
+        self.scale
+            .extend((0..n).map(|i| p.mass[i] / (dt * dt) + graph.stiffness[i]));
+        self.thickness.clear();
+        self.thickness
+            .extend(model.surfaces.iter().map(|s| s.thickness));
+        let h_max = model
+            .surfaces
+            .iter()
+            .filter(|s| s.is_active())
+            .map(|s| s.thickness)
+            .fold(0.0, f64::max);
+        self.h_max = h_max;
+        let travel = (0..n)
+            .filter(|&i| !p.is_pinned(i))
+            .map(|i| (y[i] - x[i]).norm())
+            .fold(0.0, f64::max);
+        let collider_reach = (COLLIDER_REACH * h_max).max(4.0 * travel).max(1e-6);
+        self.detect_colliders(model, x, collider_reach);
+        self.detect_features(model, x, collider_reach);
+        let surface_reach = SURFACE_REACH * h_max;
+        self.detect_surfaces(model, x, surface_reach);
+        self.index_pairs(n, p);
+        self.set_bounds(p, (x, y));
+    }
+
+    /// Per particle: the nearest collider surface (capped at `reach`) and which colliders
+    /// it may touch before the next detection.
+    fn detect_colliders(&mut self, model: &Model, x: &[Vec3], reach: f64) {
+        let topology = &self.topology;
+        let n = x.len();
+        self.point_collider.resize(n, Clearance::new(reach));
+        self.touches.resize(n, Touches::default());
+        let one = |i: usize, clearance: &mut Clearance, near: &mut Touches| {
+            let margin = match topology.surface[i] {
+                u16::MAX => 0.0,
+                s => model.surfaces[s as usize].thickness,
+            };
+            let (lo, hi) = (x[i].add_scalar(-reach), x[i].add_scalar(reach));
+            *clearance = Clearance::new(reach);
+            *near = Touches::default();
+            for (k, slot) in model.colliders.iter().enumerate() {
+                if !slot.shape.may_touch(&lo, &hi, 0.0) {
+                    continue;
+                }
+                slot.shape.contacts_within(&x[i], reach, &mut |c| {
+                    let d = reach - c.depth;
+                    // Inside already: no bound from it (staying is no crossing); its
+                    // contact pushes the particle out.
+                    let inside = d < 0.0;
+                    let felt = inside || d <= FELT * margin;
+                    if !inside {
+                        clearance.see(d, felt);
+                    }
+                    if felt {
+                        let plane = Plane {
+                            collider: k as u16,
+                            point: c.point,
+                            normal: c.normal,
+                        };
+                        near.keep(plane, d);
+                    }
+                });
+            }
+        };
+        let (clearances, near) = (&mut self.point_collider, &mut self.touches);
+        if n <= CHUNK {
+            for i in 0..n {
+                one(i, &mut clearances[i], &mut near[i]);
+            }
+        } else {
+            clearances
+                .par_chunks_mut(CHUNK)
+                .zip(near.par_chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(|(c, (cl, ne))| {
+                    for k in 0..cl.len() {
+                        one(c * CHUNK + k, &mut cl[k], &mut ne[k]);
+                    }
+                });
+        }
+    }
+
+    /// Per surface triangle: the nearest sharp collider feature (capped at `reach`), and the
+    /// feature pairs it may touch before the next detection.
+    fn detect_features(&mut self, model: &Model, x: &[Vec3], reach: f64) {
+        let triangles = &self.topology.triangles;
+        self.triangle_collider.clear();
+        self.triangle_collider
+            .resize(triangles.len(), Clearance::new(reach));
+        self.pairs.clear();
+        if !model.colliders.iter().any(|c| c.shape.has_features()) {
+            return;
+        }
+        let scale = &self.scale;
+        let found = chunked(triangles.len(), |range| {
+            let mut out = Vec::new();
+            for t in range {
+                let (tri, s) = triangles[t];
+                let [a, b, c] = tri.map(|i| &x[i as usize]);
+                let (lo, hi) = bounds_of(&[a, b, c]);
+                let h = model.surfaces[s as usize].thickness;
+                let mut clearance = Clearance::new(reach);
+                let mut pairs = Vec::new();
+                for slot in model.colliders.iter().filter(|c| c.shape.has_features()) {
+                    let (k, mu) = collider_law(
+                        &slot.response,
+                        tri.iter().map(|&i| scale[i as usize]).fold(0.0, f64::max),
+                    );
+                    slot.shape
+                        .features(&lo.add_scalar(-reach), &hi.add_scalar(reach), &mut |f| {
+                            // The boxes' distance bounds the feature's from below: a feature
+                            // no nearer than what is already known, and not felt, changes
+                            // nothing.
+                            let (flo, fhi) = f.bounds();
+                            let apart = (0..3)
+                                .map(|k| (flo[k] - hi[k]).max(lo[k] - fhi[k]).max(0.0).powi(2))
+                                .sum::<f64>()
+                                .sqrt();
+                            if apart >= clearance.nearest && apart > FELT * h {
+                                return;
+                            }
+                            let (anchor, w) = feature_triangle(&f, a, b, c);
+                            let d = (a * w[0] + b * w[1] + c * w[2] - anchor).norm();
+                            clearance.see(d, d <= FELT * h);
+                            if d <= FELT * h {
+                                pairs.push(Pair {
+                                    sides: Sides::Feature(anchor),
+                                    ids: [tri[0], tri[1], tri[2], u32::MAX],
+                                    h,
+                                    k,
+                                    mu,
+                                });
+                            }
+                        });
+                }
+                out.push((t, clearance, pairs));
+            }
+            out
+        });
+        for (t, d, pairs) in found {
+            self.triangle_collider[t] = d;
+            self.pairs.extend(pairs);
+        }
+    }
+
+    /// Point–triangle and edge–edge distances between surfaces (capped at `reach`), and the
+    /// pairs within reach.
+    fn detect_surfaces(&mut self, model: &Model, x: &[Vec3], reach: f64) {
+        let n = x.len();
+        let topo = &self.topology;
+        self.point_surface.clear();
+        self.point_surface.resize(n, Clearance::new(reach));
+        self.triangle_surface.clear();
+        self.triangle_surface
+            .resize(topo.triangles.len(), Clearance::new(reach));
+        self.edge_surface.clear();
+        self.edge_surface
+            .resize(topo.edges.len(), Clearance::new(reach));
+        if !topo.self_pairs || reach <= 0.0 {
+            return;
+        }
+        let surfaces = &model.surfaces;
+        let law = |a: u16, b: u16| -> Option<(f64, f64)> {
+            let (sa, sb) = (&surfaces[a as usize], &surfaces[b as usize]);
+            if a == b && !sa.self_collision {
+                return None;
+            }
+            Some((
+                sa.thickness.max(sb.thickness),
+                0.5 * (sa.friction + sb.friction),
+            ))
+        };
+        let scale = &self.scale;
+        let stiffness = |ids: &[u32]| {
+            CONTACT_STIFFNESS * ids.iter().map(|&i| scale[i as usize]).fold(0.0, f64::max)
+        };
+        let rest = &self.rest;
+
+        // Points against triangles.
+        let tri_boxes: Vec<(Vec3, Vec3)> = topo
+            .triangles
+            .iter()
+            .map(|(t, _)| bounds_of(&t.map(|i| &x[i as usize]).each_ref().map(|p| *p)))
+            .collect();
+        let extent = tri_boxes
+            .iter()
+            .map(|(lo, hi)| (hi - lo).max())
+            .fold(0.0, f64::max);
+        let cell = extent + reach;
+        self.triangle_grid
+            .build(cell, tri_boxes.iter().map(|(lo, _)| *lo));
+        let grid = &self.triangle_grid;
+        let found = chunked(n, |range| {
+            let mut out = Vec::new();
+            for v in range {
+                let sv = topo.surface[v];
+                if sv == u16::MAX {
+                    continue;
+                }
+                let p = &x[v];
+                cells(grid, &(p - Vec3::repeat(cell)), &p.add_scalar(reach), |c| {
+                    grid.visit(c, |t| {
+                        let (tri, st) = topo.triangles[t as usize];
+                        if tri.contains(&(v as u32)) || !within(p, &tri_boxes[t as usize], reach) {
+                            return;
+                        }
+                        let Some((h, mu)) = law(sv, st) else { return };
+                        let [a, b, c] = tri.map(|i| &x[i as usize]);
+                        let w = point_triangle(p, a, b, c);
+                        let d = (p - (a * w[0] + b * w[1] + c * w[2])).norm();
+                        if d < reach {
+                            out.push((v, t, d, h, mu));
+                        }
+                    });
+                });
+            }
+            out
+        });
+        for (v, t, d, h, mu) in found {
+            let tri = topo.triangles[t as usize].0;
+            let felt = d <= FELT * h;
+            self.point_surface[v].see(d, felt);
+            self.triangle_surface[t as usize].see(d, felt);
+            if !felt {
+                continue;
+            }
+            let ids = [v as u32, tri[0], tri[1], tri[2]];
+            let pair = Pair {
+                sides: Sides::PointTriangle(topo.owns[t as usize]),
+                ids,
+                h,
+                k: stiffness(&ids),
+                mu,
+            };
+            if stencil_distance(&pair, rest) >= h {
+                self.pairs.push(pair);
+            }
+        }
+
+        // Edges against edges, each unordered pair once (the later edge finds the earlier).
+        let edge_boxes: Vec<(Vec3, Vec3)> = topo
+            .edges
+            .iter()
+            .map(|([a, b], _)| {
+                (
+                    x[*a as usize].inf(&x[*b as usize]),
+                    x[*a as usize].sup(&x[*b as usize]),
+                )
+            })
+            .collect();
+        let extent = edge_boxes
+            .iter()
+            .map(|(lo, hi)| (hi - lo).max())
+            .fold(0.0, f64::max);
+        let cell = extent + reach;
+        self.edge_grid
+            .build(cell, edge_boxes.iter().map(|(lo, _)| *lo));
+        let grid = &self.edge_grid;
+        let found = chunked(topo.edges.len(), |range| {
+            let mut out = Vec::new();
+            for e in range {
+                let ([a, b], se) = topo.edges[e];
+                let bx = &edge_boxes[e];
+                cells(
+                    grid,
+                    &(bx.0 - Vec3::repeat(cell)),
+                    &bx.1.add_scalar(reach),
+                    |c| {
+                        grid.visit(c, |f| {
+                            let f = f as usize;
+                            if f >= e {
+                                return;
+                            }
+                            let ([c0, d0], sf) = topo.edges[f];
+                            if [c0, d0].contains(&a) || [c0, d0].contains(&b) {
+                                return;
+                            }
+                            if !boxes_within(bx, &edge_boxes[f], reach) {
+                                return;
+                            }
+                            let Some((h, mu)) = law(se, sf) else { return };
+                            let (p1, q1, p2, q2) = (
+                                &x[a as usize],
+                                &x[b as usize],
+                                &x[c0 as usize],
+                                &x[d0 as usize],
+                            );
+                            let (s, t) = segment_segment(p1, q1, p2, q2);
+                            let d = ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm();
+                            if d < reach {
+                                out.push((e, f, d, h, mu));
+                            }
+                        });
+                    },
+                );
+            }
+            out
+        });
+        for (e, f, d, h, mu) in found {
+            let felt = d <= FELT * h;
+            self.edge_surface[e].see(d, felt);
+            self.edge_surface[f].see(d, felt);
+            if !felt {
+                continue;
+            }
+            let ([a, b], _) = topo.edges[e];
+            let ([c, dd], _) = topo.edges[f];
+            let ids = [a, b, c, dd];
+            let pair = Pair {
+                sides: Sides::EdgeEdge,
+                ids,
+                h,
+                k: stiffness(&ids),
+                mu,
+            };
+            if stencil_distance(&pair, rest) >= h {
+                self.pairs.push(pair);
+            }
+        }
+    }
+
+    /// Lists each particle's pairs (a counting sort in pair order).
+    fn index_pairs(&mut self, n: usize, p: &Particles) {
+        self.start.clear();
+        self.start.resize(n + 1, 0);
+        let free = |i: u32| i != u32::MAX && !p.is_pinned(i as usize);
+        for pair in &self.pairs {
+            for &i in pair.ids.iter().filter(|&&i| free(i)) {
+                self.start[i as usize + 1] += 1;
+            }
+        }
+        for i in 0..n {
+            self.start[i + 1] += self.start[i];
+        }
+        self.refs.clear();
+        self.refs.resize(self.start[n] as usize, 0);
+        let cursor = &mut self.cursor;
+        cursor.clear();
+        cursor.extend_from_slice(&self.start);
+        for (k, pair) in self.pairs.iter().enumerate() {
+            for &i in pair.ids.iter().filter(|&&i| free(i)) {
+                self.refs[cursor[i as usize] as usize] = k as u32;
+                cursor[i as usize] += 1;
+            }
+        }
+    }
+
+    /// Each particle's ball: the shared translation `u` and the radii (see the module docs).
+    fn set_bounds(&mut self, p: &Particles, (x, y): (&[Vec3], &[Vec3])) {
+        let n = x.len();
+        let topo = &self.topology;
+        // Nearest collider of each particle, its triangles' features included.
+        let mut collider = std::mem::take(&mut self.scratch_collider);
+        collider.clear();
+        collider.extend_from_slice(&self.point_collider);
+        let mut own = std::mem::take(&mut self.scratch_own);
+        own.clear();
+        own.extend_from_slice(&self.point_surface);
+        for (t, (tri, _)) in topo.triangles.iter().enumerate() {
+            for &i in tri {
+                let i = i as usize;
+                collider[i].meet(&self.triangle_collider[t]);
+                own[i].meet(&self.triangle_surface[t]);
+            }
+        }
+        for (e, (edge, _)) in topo.edges.iter().enumerate() {
+            for &i in edge {
+                own[i as usize].meet(&self.edge_surface[e]);
+            }
+        }
+        let h_max = self.h_max;
+        let margin = |i: usize| match topo.surface[i] {
+            u16::MAX => 0.0,
+            s => self.thickness[s as usize],
+        };
+        let mut allowed = std::mem::take(&mut self.scratch_allowed);
+        allowed.clear();
+        allowed.extend((0..n).map(|i| collider[i].allows(GAMMA_COLLIDER, margin(i), 1.0)));
+        // The shared translation: the surfaces' mean inertial displacement, unless a
+        // surface particle is pinned (it cannot follow) or it would use more than half of
+        // what a collider allows some surface particle (a cloth on a table whose edges
+        // fall), when it would only eat the bounds of the particles that touch.
+        self.shifted.clear();
+        self.shifted
+            .extend((0..n).map(|i| topo.surface[i] != u16::MAX));
+        let mut sum = Vec3::zeros();
+        let mut mass = 0.0;
+        let mut pinned = false;
+        let mut room = f64::INFINITY;
+        for i in (0..n).filter(|&i| self.shifted[i]) {
+            if p.is_pinned(i) {
+                pinned = true;
+            } else {
+                sum += (y[i] - x[i]) * p.mass[i];
+                mass += p.mass[i];
+                room = room.min(allowed[i]);
+            }
+        }
+        let mut u = if pinned || mass == 0.0 {
+            Vec3::zeros()
+        } else {
+            sum / mass
+        };
+        if u.norm() > 0.5 * room {
+            u = Vec3::zeros();
+        }
+        self.shift = u;
+        let shift = u.norm();
+        self.bound.clear();
+        self.bound.extend((0..n).map(|i| {
+            let mut b = allowed[i];
+            if self.shifted[i] {
+                b -= shift;
+                if topo.self_pairs {
+                    b = b.min(own[i].allows(GAMMA_SURFACE, h_max, 2.0));
+                }
+            }
+            b.max(0.0)
+        }));
+        self.scratch_collider = collider;
+        self.scratch_own = own;
+        self.scratch_allowed = allowed;
+    }
+}
+
+/// The length of a pair's gap at `x`.
+fn stencil_distance(pair: &Pair, x: &[Vec3]) -> f64 {
+    let (w, anchor, len, _) = stencil(pair, x);
+    let mut g = -anchor;
+    for k in 0..len {
+        g += x[pair.ids[k] as usize] * w[k];
+    }
+    g.norm()
+}

@@ -1,0 +1,294 @@
+//! Vertex block descent (Chen et al., SIGGRAPH 2024) for implicit Euler, with every update
+//! held inside a displacement bound so that no surface crosses a collider or another surface
+//! (after the offset geometric contact of Chen et al., SIGGRAPH 2025). docs/physics.md §4.6
+//! is the contract; in short:
+//!
+//! * A step minimises the implicit-Euler energy `Σ m/(2dt²) |x - y|² + E(x)` over the
+//!   positions `x`, with `y = x₀ + dt v₀ + dt² f_ext / m` and `E` the springs, attachments,
+//!   drag and contacts (damping enters as `kd/dt` on the step's displacement).
+//! * Iterations visit the particles colour by colour (no spring inside a colour); each takes
+//!   one 3×3 Newton step on its own energy, others fixed. Within a colour every update reads
+//!   the positions the colour started with, so the result is the same on any thread count.
+//! * Every update is clipped to its particle's ball from the last detection (`detect.rs`);
+//!   an iteration that clipped any particle ends with a new detection.
+//! * The step stops when an iteration moves no particle more than [`TOLERANCE`] of the
+//!   step's largest displacement (and clipped none), or after [`MAX_ITERATIONS`]. Then
+//!   `v = (x - x₀) / dt`.
+
+mod detect;
+mod graph;
+mod local;
+
+use super::{StepReport, Workspace};
+use crate::model::Model;
+use crate::particles::{Particles, Vec3};
+use detect::Detection;
+use graph::Graph;
+use local::Local;
+use rayon::prelude::*;
+
+/// Block descent is implicit Euler: stable for every step.
+pub(super) const STABILITY_RADIUS: f64 = f64::INFINITY;
+/// Iterations at most per step.
+pub const MAX_ITERATIONS: usize = 24;
+/// The step has converged when no particle moved more than this share of the step's
+/// largest displacement in the last iteration.
+pub const TOLERANCE: f64 = 1e-4;
+/// Displacements below this (metres) count as converged whatever the step's scale.
+const FLOOR: f64 = 1e-10;
+/// The spectral radius assumed by the Chebyshev acceleration (0: none).
+const CHEBYSHEV: f64 = 0.9;
+/// Detections at most while the first guess is clipped.
+const GUESS_DETECTIONS: usize = 8;
+/// Particles per parallel chunk of a colour.
+const CHUNK: usize = 256;
+
+/// Buffers of the block-descent step, kept between steps.
+#[derive(Clone, Debug, Default)]
+pub struct VbdBuffers {
+    graph: Graph,
+    detection: Detection,
+    /// Inertial targets.
+    target: Vec<Vec3>,
+    /// Per particle: `m v + dt f_ext`, its momentum after the step were it free.
+    momentum: Vec<Vec3>,
+    /// Positions at the last detection.
+    detected: Vec<Vec3>,
+    /// One colour's new positions and whether each was clipped.
+    next: Vec<(Vec3, bool)>,
+    /// Velocities at the start of the last step (for the first guess).
+    previous: Vec<Vec3>,
+    /// The last two iterates (for the acceleration).
+    old: Vec<Vec3>,
+    older: Vec<Vec3>,
+    /// Iterations and detections of the last step.
+    pub(crate) iterations: usize,
+    pub(crate) detections: usize,
+}
+
+pub(super) fn step(
+    model: &Model,
+    p: &mut Particles,
+    (t, dt): (f64, f64),
+    ws: &mut Workspace,
+) -> StepReport {
+    let n = p.len();
+    ws.x0.copy_from_slice(&p.x);
+    let air = ws.air.evaluate(model, &p.x, &p.v, t);
+    let b = &mut ws.vbd;
+    if !b.graph.fits(n, model.springs.len()) {
+        b.graph = Graph::new(model, p);
+    }
+    b.target.clear();
+    b.target.extend((0..n).map(|i| {
+        if p.is_pinned(i) {
+            return p.x[i];
+        }
+        let mut f = model.gravity * p.mass[i];
+        if let Some(field) = &model.field {
+            f += field.sample(&p.x[i]);
+        }
+        if let Some(a) = air.get(i) {
+            f += a;
+        }
+        p.x[i] + p.v[i] * dt + f * (dt * dt / p.mass[i])
+    }));
+    // Each particle's momentum after the step, were it free: `m v + dt f_ext`.
+    b.momentum.clear();
+    b.momentum.extend((0..n).map(|i| {
+        let mut f = model.gravity * p.mass[i];
+        if let Some(field) = &model.field {
+            f += field.sample(&p.x[i]);
+        }
+        if let Some(a) = air.get(i) {
+            f += a;
+        }
+        p.v[i] * p.mass[i] + f * dt
+    }));
+    b.detection
+        .detect(model, p, &b.graph, (&p.x, &b.target), dt);
+    b.detected.clear();
+    b.detected.extend_from_slice(&p.x);
+    b.detections = 1;
+    // The first guess (Chen et al. 2024, §3.7): the inertial motion with as much of
+    // gravity as the particle showed last step (none for a cloth at rest on a table, all of
+    // it in free fall), clipped; while the clipping holds the guess back, detected anew
+    // from where it got to (a fast fall crosses several bounds in one step).
+    let g = model.gravity.norm();
+    let fresh = b.previous.len() != n;
+    b.next.clear();
+    b.next.extend((0..n).map(|i| {
+        let share = if fresh || g == 0.0 {
+            1.0
+        } else {
+            let a = (p.v[i] - b.previous[i]) / dt;
+            (a.dot(&model.gravity) / (g * g)).clamp(0.0, 1.0)
+        };
+        (
+            p.x[i] + p.v[i] * dt + model.gravity * (share * dt * dt),
+            false,
+        )
+    }));
+    for round in 0..GUESS_DETECTIONS {
+        let mut clipped = false;
+        for i in 0..n {
+            // Past the first round only particles that feel no contact follow the guess:
+            // it knows nothing of contacts, and would drag a particle into one a bound
+            // at a time.
+            if !p.is_pinned(i) && (round == 0 || !b.detection.may_touch(i)) {
+                let (x, c) = clip(&b.detection, &b.detected, i, b.next[i].0);
+                p.x[i] = x;
+                clipped |= c;
+            }
+        }
+        if !clipped || round + 1 == GUESS_DETECTIONS {
+            break;
+        }
+        b.detection
+            .detect(model, p, &b.graph, (&p.x, &b.target), dt);
+        b.detected.copy_from_slice(&p.x);
+        b.detections += 1;
+    }
+    recolour(&mut b.graph, &b.detection, p);
+    b.previous.clear();
+    b.previous.extend_from_slice(&p.v);
+    b.older.clear();
+    b.older.extend_from_slice(&p.x);
+    b.old.clear();
+    b.old.extend_from_slice(&p.x);
+    let mut omega = 1.0;
+    let mut since_detection = 0;
+    let start = &ws.x0;
+    let mut iterations = 0;
+    while iterations < MAX_ITERATIONS {
+        iterations += 1;
+        let mut largest = 0.0_f64;
+        let mut clipped = false;
+        for colour in &b.graph.colours {
+            let local = Local {
+                model,
+                graph: &b.graph,
+                detection: &b.detection,
+                mass: &p.mass,
+                start,
+                target: &b.target,
+                dt,
+            };
+            let (x, detected, detection) = (&p.x, &b.detected, &b.detection);
+            b.next.resize(colour.len(), (Vec3::zeros(), false));
+            let update = |ids: &[u32], out: &mut [(Vec3, bool)]| {
+                for (k, &i) in ids.iter().enumerate() {
+                    let i = i as usize;
+                    out[k] = clip(detection, detected, i, local.solve(i, x));
+                }
+            };
+            if colour.len() <= CHUNK {
+                update(colour, &mut b.next);
+            } else {
+                colour
+                    .par_chunks(CHUNK)
+                    .zip(b.next.par_chunks_mut(CHUNK))
+                    .for_each(|(ids, out)| update(ids, out));
+            }
+            for (&i, &(xi, c)) in colour.iter().zip(&b.next) {
+                let i = i as usize;
+                largest = largest.max((xi - p.x[i]).norm());
+                clipped |= c;
+                p.x[i] = xi;
+            }
+        }
+        let scale =
+            p.x.iter()
+                .zip(start)
+                .map(|(x, s)| (x - s).norm())
+                .fold(0.0, f64::max);
+        if !clipped && largest <= TOLERANCE * scale.max(g * dt * dt) + FLOOR {
+            break;
+        }
+        // Chebyshev semi-iterative acceleration (Wang 2015, as Chen et al. 2024 use it),
+        // restarted at each detection; each result clipped again.
+        since_detection += 1;
+        if since_detection >= 2 && CHEBYSHEV > 0.0 && iterations < MAX_ITERATIONS {
+            omega = if since_detection == 2 {
+                2.0 / (2.0 - CHEBYSHEV * CHEBYSHEV)
+            } else {
+                4.0 / (4.0 - CHEBYSHEV * CHEBYSHEV * omega)
+            };
+            for i in 0..n {
+                // Contacts are not smooth: particles that may touch are not extrapolated.
+                if !p.is_pinned(i) && !b.detection.may_touch(i) {
+                    let to = b.older[i] + (p.x[i] - b.older[i]) * omega;
+                    p.x[i] = clip(&b.detection, &b.detected, i, to).0;
+                }
+            }
+        }
+        std::mem::swap(&mut b.older, &mut b.old);
+        b.old.copy_from_slice(&p.x);
+        if clipped && iterations < MAX_ITERATIONS {
+            b.detection
+                .detect(model, p, &b.graph, (&p.x, &b.target), dt);
+            recolour(&mut b.graph, &b.detection, p);
+            b.detected.copy_from_slice(&p.x);
+            b.detections += 1;
+            since_detection = 0;
+            b.older.copy_from_slice(&p.x);
+        }
+    }
+    b.iterations = iterations;
+    for ((v, x), s) in p.v.iter_mut().zip(&p.x).zip(start) {
+        *v = (x - s) / dt;
+    }
+    // Springs and contacts between the bodies' own particles are internal forces, so
+    // implicit Euler's step changes the momentum by `dt Σ f_ext` exactly; the iterations
+    // stop short of that. When nothing else acts (no collider, pin, attachment or drag),
+    // the leftover is spread as one velocity, which moves no particle relative to another
+    // (no crossing), and momentum is kept to round-off, as the other integrators keep it.
+    let closed = model.colliders.is_empty()
+        && model.attachments.is_empty()
+        && model.drag == 0.0
+        && (0..n).all(|i| !p.is_pinned(i));
+    if closed {
+        let mut want = Vec3::zeros();
+        let mut have = Vec3::zeros();
+        let mut mass = 0.0;
+        for i in 0..n {
+            want += b.momentum[i];
+            have += p.v[i] * p.mass[i];
+            mass += p.mass[i];
+        }
+        let dv = (want - have) / mass;
+        for ((v, x), s) in p.v.iter_mut().zip(&mut p.x).zip(start) {
+            *v += dv;
+            *x = s + *v * dt;
+        }
+    }
+    StepReport::SAVED
+}
+
+/// Colours the particles anew when the detection found pairs, so that no two particles of
+/// a pair move in one colour (they would both close the same gap and overshoot it); the
+/// springs' colouring otherwise, kept from the last time.
+fn recolour(graph: &mut Graph, detection: &Detection, p: &Particles) {
+    if detection.has_pairs() || graph.coloured_with_contacts {
+        graph.colour(p, |i, f| detection.partners(i, f));
+        graph.coloured_with_contacts = detection.has_pairs();
+    }
+}
+
+/// `to` clipped to particle `i`'s ball, and whether it had to be.
+#[inline]
+fn clip(detection: &Detection, detected: &[Vec3], i: usize, to: Vec3) -> (Vec3, bool) {
+    let centre = if detection.shifted[i] {
+        detected[i] + detection.shift
+    } else {
+        detected[i]
+    };
+    let r = detection.bound[i];
+    let off = to - centre;
+    let len = off.norm();
+    if len <= r {
+        (to, false)
+    } else {
+        (centre + off * (r / len), true)
+    }
+}
