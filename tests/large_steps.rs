@@ -1,4 +1,4 @@
-//! Block descent (`integrator = "vbd"`, docs/physics.md §4.6): implicit Euler at steps of a
+//! Block descent (`integrator = "vbd"`, docs/physics.md §4.1): implicit Euler at steps of a
 //! display frame, checked against closed forms (a spring's period and decay, a sheet at rest
 //! on a plane, a sheet sliding down an incline with friction), against the small-step
 //! symplectic runs of the built-in cloth scenes, and for crossings on every exported frame
@@ -189,7 +189,7 @@ friction = 0.5
 /// A sheet on a 30° incline with Coulomb friction μ = 0.3 slides with the acceleration of
 /// a block, `g (sin θ - μ cos θ)` = 2.357 m/s², within 1 %, at 16 steps per 60 Hz frame.
 /// (At larger steps the iterations stop before a sheet sliding as a whole has converged:
-/// it slides, slower; docs/physics.md §4.6 gives the figures.)
+/// it slides, slower; docs/physics.md §4.1 gives the figures.)
 #[test]
 fn a_sheet_sliding_on_an_incline_accelerates_at_g_sin_minus_mu_cos() {
     let (theta, mu, h) = (30.0_f64.to_radians(), 0.3, 0.005);
@@ -303,7 +303,7 @@ fn at_a_frame_per_step_cloth_drapes_the_square_table_without_crossing() {
 /// The pile is a buckling fold, and at a frame per step implicit Euler's damping and the
 /// friction hold folds that the small-step run lets fall flat: the mean height agrees within
 /// 3 cm (5.4 against 2.8 cm when this was written), the share on the ground is not compared
-/// (docs/physics.md §4.6).
+/// (docs/physics.md §4.1).
 #[test]
 fn at_a_frame_per_step_the_cloth_pile_folds_without_crossing() {
     frame_rate_drape_agrees("cloth-pile", None, 0.0, None, 0.03);

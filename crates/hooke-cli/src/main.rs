@@ -72,7 +72,7 @@ enum Command {
 #[derive(Args, Clone, Default)]
 struct SetupArgs {
     /// Integrator: euler, symplectic, midpoint, rk4, implicit or vbd (block descent: one
-    /// crossing-free implicit step per display frame, docs/physics.md §4.6).
+    /// crossing-free implicit step per display frame, docs/physics.md §4.1).
     #[arg(long)]
     integrator: Option<Integrator>,
     /// Step size in seconds.
@@ -102,7 +102,7 @@ fn parse_every(s: &str) -> Result<u64, String> {
 }
 
 /// A time in seconds: finite and positive.
-fn parse_seconds(s: &str) -> Result<f64, String> {
+pub(crate) fn parse_seconds(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
         Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
         _ => Err(format!("expected a time in seconds > 0, found '{s}'")),

@@ -141,7 +141,7 @@ fn large_step_advice(scene: &Scene, estimate: &StabilityEstimate) -> Option<Stri
     Some(format!(
         "recommendation: explicit steps here must stay below {limit:.3e} s ({:.0} steps per \
          simulated second); `--integrator vbd --dt 0.016666666666666666` takes one implicit \
-         step per 60 Hz frame with no crossing (docs/physics.md §4.6)",
+         step per 60 Hz frame with no crossing (docs/physics.md §4.1)",
         1.0 / limit
     ))
 }
@@ -396,7 +396,7 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
     if sim.integrator() == Integrator::Vbd {
         println!(
             "contacts: vbd bounds every update, so no surface crosses a collider or another \
-             surface at any dt (docs/physics.md §4.6)"
+             surface at any dt (docs/physics.md §4.1)"
         );
         return Ok(ExitCode::SUCCESS);
     }

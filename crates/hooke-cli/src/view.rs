@@ -45,6 +45,13 @@ pub struct ViewArgs {
     /// must see the same motion on a loaded machine as on a quiet one.
     #[arg(long, value_name = "SECONDS", value_parser = parse_clock)]
     clock: Option<f64>,
+    /// Step every scene with this integrator (default: each scene's own), e.g. `vbd` with
+    /// `--dt 0.016666666666666666` for a large cloth at one step per frame.
+    #[arg(long)]
+    integrator: Option<hooke_core::Integrator>,
+    /// Step every scene with this step size in seconds (default: each scene's own).
+    #[arg(long, value_parser = crate::parse_seconds)]
+    dt: Option<f64>,
 }
 
 /// A frame's simulated time: finite, positive, at most a second.
@@ -91,6 +98,8 @@ impl Families {
 
 struct Viewer {
     scenes: Vec<String>,
+    /// The integrator and step every scene is loaded with.
+    overrides: Overrides,
     current: usize,
     scene: Scene,
     camera: Camera,
@@ -110,8 +119,8 @@ struct Viewer {
     shots: u32,
 }
 
-fn load(arg: &str) -> Result<(Scene, Camera)> {
-    let scene = source::build(arg, &Overrides::default())?;
+fn load(arg: &str, overrides: &Overrides) -> Result<(Scene, Camera)> {
+    let scene = source::build(arg, overrides)?;
     let camera = frame_camera(&scene, DEFAULT_YAW_PITCH.0, DEFAULT_YAW_PITCH.1);
     // Room for the motion to come: cloth swings, jelly falls, chains sway.
     let camera = Camera {
@@ -122,10 +131,11 @@ fn load(arg: &str) -> Result<(Scene, Camera)> {
 }
 
 impl Viewer {
-    fn new(scenes: Vec<String>) -> Result<Self> {
-        let (scene, camera) = load(&scenes[0])?;
+    fn new(scenes: Vec<String>, overrides: Overrides) -> Result<Self> {
+        let (scene, camera) = load(&scenes[0], &overrides)?;
         Ok(Self {
             scenes,
+            overrides,
             current: 0,
             scene,
             camera,
@@ -143,7 +153,7 @@ impl Viewer {
     }
 
     fn switch(&mut self, index: usize) -> Result<()> {
-        let (scene, camera) = load(&self.scenes[index])?;
+        let (scene, camera) = load(&self.scenes[index], &self.overrides)?;
         self.current = index;
         self.scene = scene;
         self.camera = camera;
@@ -353,6 +363,11 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
     for s in &scenes {
         source::read(s)?;
     }
+    let overrides = Overrides {
+        integrator: args.integrator,
+        dt: args.dt,
+        ..Overrides::default()
+    };
     std::fs::create_dir_all(&args.screenshots).with_context(|| {
         format!(
             "cannot create screenshot folder {}",
@@ -368,7 +383,7 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
         )
     })?;
     window.set_target_fps(0);
-    let mut viewer = Viewer::new(scenes)?;
+    let mut viewer = Viewer::new(scenes, overrides)?;
     let mut renderer = Renderer::default();
     let pool = hooke_cli::threads::pool(None, "--threads")?;
     let mut buffer = vec![0u32; w * h];

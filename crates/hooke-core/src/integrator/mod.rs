@@ -40,7 +40,7 @@ pub enum Integrator {
     /// conjugate gradients (Baraff & Witkin 1998). Order 1; stable for any `dt`, damps.
     Implicit,
     /// Implicit Euler solved by vertex block descent, every update bounded so that no
-    /// surface crosses a collider or another surface (docs/physics.md §4.6). Order 1; stable
+    /// surface crosses a collider or another surface (docs/physics.md §4.1). Order 1; stable
     /// for any `dt`, damps; contacts at the bodies' thickness, with friction.
     Vbd,
 }

@@ -1,7 +1,7 @@
 //! Detection for block descent: the contacts each particle's local solve feels, and the
 //! displacement bound that keeps every surface from crossing a collider or another surface
 //! until the next detection (the offset-bound idea of Chen et al. 2025, written for this
-//! model's colliders and surfaces; docs/physics.md §4.6).
+//! model's colliders and surfaces; docs/physics.md §4.1).
 //!
 //! Each particle `v` moves, between two detections, within a ball of radius `b_v` around
 //! `x_v + u` (positions at the detection; `u` a translation shared by every surface
@@ -19,7 +19,7 @@
 
 use super::graph::Graph;
 use crate::collider::Feature;
-use crate::contact::grid::Grid;
+use crate::contact::grid::{Cell, Grid};
 use crate::contact::proximity::{point_triangle, segment_segment, segment_triangle};
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
@@ -358,16 +358,41 @@ fn boxes_within(a: &(Vec3, Vec3), b: &(Vec3, Vec3), r: f64) -> bool {
     (0..3).all(|k| a.0[k] <= b.1[k] + r && b.0[k] <= a.1[k] + r)
 }
 
-/// Calls `f` for every cell from `lo`'s to `hi`'s.
-fn cells(grid: &Grid, lo: &Vec3, hi: &Vec3, mut f: impl FnMut([i64; 3])) {
-    let (a, b) = (grid.cell_of(lo), grid.cell_of(hi));
-    for i in a[0]..=b[0] {
-        for j in a[1]..=b[1] {
-            for k in a[2]..=b[2] {
-                f([i, j, k]);
+/// Calls `test(q, candidates, out)` for every query `q` whose cell is `cells[q]`, with the
+/// items of the 27 cells around that cell (every item whose low corner lies within one cell
+/// of the query's), gathered once per occupied cell. Results come in the order of (cell,
+/// query): fixed by the positions alone, never by threads.
+fn by_cell<T: Send>(
+    grid: &Grid,
+    cells: &[Cell],
+    test: impl Fn(usize, &[u32], &mut Vec<T>) + Sync + Send,
+) -> Vec<T> {
+    let mut order: Vec<u32> = (0..cells.len() as u32).collect();
+    order.sort_unstable_by_key(|&q| (cells[q as usize], q));
+    let mut starts: Vec<usize> = (0..order.len())
+        .filter(|&k| k == 0 || cells[order[k] as usize] != cells[order[k - 1] as usize])
+        .collect();
+    starts.push(order.len());
+    chunked(starts.len() - 1, |groups| {
+        let mut out = Vec::new();
+        let mut candidates = Vec::new();
+        for g in groups {
+            let members = &order[starts[g]..starts[g + 1]];
+            let c = cells[members[0] as usize];
+            candidates.clear();
+            for i in -1..=1 {
+                for j in -1..=1 {
+                    for k in -1..=1 {
+                        grid.visit([c[0] + i, c[1] + j, c[2] + k], |t| candidates.push(t));
+                    }
+                }
+            }
+            for &q in members {
+                test(q as usize, &candidates, &mut out);
             }
         }
-    }
+        out
+    })
 }
 
 /// The normal stiffness and Coulomb coefficient a collider's response gives a contact with
@@ -628,31 +653,26 @@ impl Detection {
         self.triangle_grid
             .build(cell, tri_boxes.iter().map(|(lo, _)| *lo));
         let grid = &self.triangle_grid;
-        let found = chunked(n, |range| {
-            let mut out = Vec::new();
-            for v in range {
-                let sv = topo.surface[v];
-                if sv == u16::MAX {
+        let at: Vec<Cell> = x.iter().map(|p| grid.cell_of(p)).collect();
+        let found = by_cell(grid, &at, |v, candidates, out| {
+            let sv = topo.surface[v];
+            if sv == u16::MAX {
+                return;
+            }
+            let p = &x[v];
+            for &t in candidates {
+                let (tri, st) = topo.triangles[t as usize];
+                if tri.contains(&(v as u32)) || !within(p, &tri_boxes[t as usize], reach) {
                     continue;
                 }
-                let p = &x[v];
-                cells(grid, &(p - Vec3::repeat(cell)), &p.add_scalar(reach), |c| {
-                    grid.visit(c, |t| {
-                        let (tri, st) = topo.triangles[t as usize];
-                        if tri.contains(&(v as u32)) || !within(p, &tri_boxes[t as usize], reach) {
-                            return;
-                        }
-                        let Some((h, mu)) = law(sv, st) else { return };
-                        let [a, b, c] = tri.map(|i| &x[i as usize]);
-                        let w = point_triangle(p, a, b, c);
-                        let d = (p - (a * w[0] + b * w[1] + c * w[2])).norm();
-                        if d < reach {
-                            out.push((v, t, d, h, mu));
-                        }
-                    });
-                });
+                let Some((h, mu)) = law(sv, st) else { continue };
+                let [a, b, c] = tri.map(|i| &x[i as usize]);
+                let w = point_triangle(p, a, b, c);
+                let d = (p - (a * w[0] + b * w[1] + c * w[2])).norm();
+                if d < reach {
+                    out.push((v, t, d, h, mu));
+                }
             }
-            out
         });
         for (v, t, d, h, mu) in found {
             let tri = topo.triangles[t as usize].0;
@@ -694,45 +714,35 @@ impl Detection {
         self.edge_grid
             .build(cell, edge_boxes.iter().map(|(lo, _)| *lo));
         let grid = &self.edge_grid;
-        let found = chunked(topo.edges.len(), |range| {
-            let mut out = Vec::new();
-            for e in range {
-                let ([a, b], se) = topo.edges[e];
-                let bx = &edge_boxes[e];
-                cells(
-                    grid,
-                    &(bx.0 - Vec3::repeat(cell)),
-                    &bx.1.add_scalar(reach),
-                    |c| {
-                        grid.visit(c, |f| {
-                            let f = f as usize;
-                            if f >= e {
-                                return;
-                            }
-                            let ([c0, d0], sf) = topo.edges[f];
-                            if [c0, d0].contains(&a) || [c0, d0].contains(&b) {
-                                return;
-                            }
-                            if !boxes_within(bx, &edge_boxes[f], reach) {
-                                return;
-                            }
-                            let Some((h, mu)) = law(se, sf) else { return };
-                            let (p1, q1, p2, q2) = (
-                                &x[a as usize],
-                                &x[b as usize],
-                                &x[c0 as usize],
-                                &x[d0 as usize],
-                            );
-                            let (s, t) = segment_segment(p1, q1, p2, q2);
-                            let d = ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm();
-                            if d < reach {
-                                out.push((e, f, d, h, mu));
-                            }
-                        });
-                    },
+        let at: Vec<Cell> = edge_boxes.iter().map(|(lo, _)| grid.cell_of(lo)).collect();
+        let found = by_cell(grid, &at, |e, candidates, out| {
+            let ([a, b], se) = topo.edges[e];
+            let bx = &edge_boxes[e];
+            for &f in candidates {
+                let f = f as usize;
+                if f >= e {
+                    continue;
+                }
+                let ([c0, d0], sf) = topo.edges[f];
+                if [c0, d0].contains(&a) || [c0, d0].contains(&b) {
+                    continue;
+                }
+                if !boxes_within(bx, &edge_boxes[f], reach) {
+                    continue;
+                }
+                let Some((h, mu)) = law(se, sf) else { continue };
+                let (p1, q1, p2, q2) = (
+                    &x[a as usize],
+                    &x[b as usize],
+                    &x[c0 as usize],
+                    &x[d0 as usize],
                 );
+                let (s, t) = segment_segment(p1, q1, p2, q2);
+                let d = ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm();
+                if d < reach {
+                    out.push((e, f, d, h, mu));
+                }
             }
-            out
         });
         for (e, f, d, h, mu) in found {
             let felt = d <= FELT * h;

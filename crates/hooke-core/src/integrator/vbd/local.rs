@@ -1,5 +1,5 @@
 //! One particle's block update: a Newton step on its share of the implicit-Euler energy,
-//! the others held where they are (docs/physics.md §4.6).
+//! the others held where they are (docs/physics.md §4.1).
 
 use super::detect::{Detection, collider_law, stencil};
 use super::graph::Graph;
@@ -36,7 +36,33 @@ pub(super) struct Local<'a> {
 struct Block {
     f: Vec3,
     h: Sym3,
-    gaps: Vec<(f64, Vec3)>,
+    gaps: Gaps,
+}
+
+/// Gaps kept inline: a particle rarely has more than a few contacts, and a heap
+/// allocation per particle and iteration would cost more than its solve.
+const INLINE_GAPS: usize = 16;
+
+#[derive(Default)]
+struct Gaps {
+    count: usize,
+    inline: [(f64, Vec3); INLINE_GAPS],
+    more: Vec<(f64, Vec3)>,
+}
+
+impl Gaps {
+    fn push(&mut self, gap: (f64, Vec3)) {
+        if self.count < INLINE_GAPS {
+            self.inline[self.count] = gap;
+            self.count += 1;
+        } else {
+            self.more.push(gap);
+        }
+    }
+
+    fn iter(&self) -> impl Iterator<Item = &(f64, Vec3)> {
+        self.inline[..self.count].iter().chain(&self.more)
+    }
 }
 
 impl Block {
@@ -105,7 +131,7 @@ impl Local<'_> {
         let mut b = Block {
             f: (self.target[i] - xi) * inertia,
             h: Sym3::default().plus_identity(inertia),
-            gaps: Vec::new(),
+            gaps: Gaps::default(),
         };
         let model = self.model;
         if model.drag != 0.0 {

@@ -1,6 +1,6 @@
 //! Vertex block descent (Chen et al., SIGGRAPH 2024) for implicit Euler, with every update
 //! held inside a displacement bound so that no surface crosses a collider or another surface
-//! (after the offset geometric contact of Chen et al., SIGGRAPH 2025). docs/physics.md §4.6
+//! (after the offset geometric contact of Chen et al., SIGGRAPH 2025). docs/physics.md §4.1
 //! is the contract; in short:
 //!
 //! * A step minimises the implicit-Euler energy `Σ m/(2dt²) |x - y|² + E(x)` over the
