@@ -54,7 +54,7 @@ def cli_trajectory(tmp_path, *args):
 def test_a_trajectory_stepped_from_python_is_the_commands_bit_for_bit(tmp_path, source, steps, every):
     path = str(ROOT / source) if source.endswith(".w") else source
     large = {"integrator": "vbd", "dt": 1 / 60} if source == "cloth-pile" else {}
-    flags = [a for k, v in large.items() for a in (f"--{k}", repr(v))]
+    flags = [a for k, v in large.items() for a in (f"--{k}", str(v))]
     frames = cli_trajectory(tmp_path, path, "--steps", str(steps), "--every", str(every), *flags)
     sim = hooke.load(path, steps=steps, every=every, **large)
     assert sim.integrator == large.get("integrator", sim.integrator)

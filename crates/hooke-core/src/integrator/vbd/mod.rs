@@ -79,38 +79,35 @@ pub(super) fn step(
     if !b.graph.fits(n, model.springs.len()) {
         b.graph = Graph::new(model, p);
     }
+    // Inertial targets `x + dt v + dt² f_ext/m`, and each particle's momentum after the
+    // step were it free, `m v + dt f_ext`.
+    let external = |i: usize| {
+        let mut f = model.gravity * p.mass[i];
+        if let Some(field) = &model.field {
+            f += field.sample(&p.x[i]);
+        }
+        if let Some(a) = air.get(i) {
+            f += a;
+        }
+        f
+    };
     b.target.clear();
-    b.target.extend((0..n).map(|i| {
-        if p.is_pinned(i) {
-            return p.x[i];
-        }
-        let mut f = model.gravity * p.mass[i];
-        if let Some(field) = &model.field {
-            f += field.sample(&p.x[i]);
-        }
-        if let Some(a) = air.get(i) {
-            f += a;
-        }
-        p.x[i] + p.v[i] * dt + f * (dt * dt / p.mass[i])
-    }));
-    // Each particle's momentum after the step, were it free: `m v + dt f_ext`.
     b.momentum.clear();
-    b.momentum.extend((0..n).map(|i| {
-        let mut f = model.gravity * p.mass[i];
-        if let Some(field) = &model.field {
-            f += field.sample(&p.x[i]);
-        }
-        if let Some(a) = air.get(i) {
-            f += a;
-        }
-        p.v[i] * p.mass[i] + f * dt
-    }));
+    for i in 0..n {
+        let f = external(i);
+        b.target.push(if p.is_pinned(i) {
+            p.x[i]
+        } else {
+            p.x[i] + p.v[i] * dt + f * (dt * dt / p.mass[i])
+        });
+        b.momentum.push(p.v[i] * p.mass[i] + f * dt);
+    }
     b.detection
         .detect(model, p, &b.graph, (&p.x, &b.target), dt);
     b.detected.clear();
     b.detected.extend_from_slice(&p.x);
     b.detections = 1;
-    // The first guess (Chen et al. 2024, §3.7): the inertial motion with as much of
+    // The first guess (after Chen et al. 2024's adaptive one): the inertial motion with as much of
     // gravity as the particle showed last step (none for a cloth at rest on a table, all of
     // it in free fall), clipped; while the clipping holds the guess back, detected anew
     // from where it got to (a fast fall crosses several bounds in one step).
@@ -238,31 +235,37 @@ pub(super) fn step(
     for ((v, x), s) in p.v.iter_mut().zip(&p.x).zip(start) {
         *v = (x - s) / dt;
     }
-    // Springs and contacts between the bodies' own particles are internal forces, so
-    // implicit Euler's step changes the momentum by `dt Σ f_ext` exactly; the iterations
-    // stop short of that. When nothing else acts (no collider, pin, attachment or drag),
-    // the leftover is spread as one velocity, which moves no particle relative to another
-    // (no crossing), and momentum is kept to round-off, as the other integrators keep it.
+    keep_momentum(model, p, start, &b.momentum, dt);
+    StepReport::SAVED
+}
+
+/// Springs and contacts between the bodies' own particles are internal forces, so implicit
+/// Euler's step changes the momentum by `dt Σ f_ext` exactly (`momentum`: each particle's
+/// `m v + dt f_ext`); the iterations stop short of that. When nothing else acts (no
+/// collider, pin, attachment or drag), the leftover is spread as one velocity, which moves
+/// no particle relative to another (no crossing), and momentum is kept to round-off, as
+/// the other integrators keep it.
+fn keep_momentum(model: &Model, p: &mut Particles, start: &[Vec3], momentum: &[Vec3], dt: f64) {
     let closed = model.colliders.is_empty()
         && model.attachments.is_empty()
         && model.drag == 0.0
-        && (0..n).all(|i| !p.is_pinned(i));
-    if closed {
-        let mut want = Vec3::zeros();
-        let mut have = Vec3::zeros();
-        let mut mass = 0.0;
-        for i in 0..n {
-            want += b.momentum[i];
-            have += p.v[i] * p.mass[i];
-            mass += p.mass[i];
-        }
-        let dv = (want - have) / mass;
-        for ((v, x), s) in p.v.iter_mut().zip(&mut p.x).zip(start) {
-            *v += dv;
-            *x = s + *v * dt;
-        }
+        && (0..p.len()).all(|i| !p.is_pinned(i));
+    if !closed {
+        return;
     }
-    StepReport::SAVED
+    let mut want = Vec3::zeros();
+    let mut have = Vec3::zeros();
+    let mut mass = 0.0;
+    for i in 0..p.len() {
+        want += momentum[i];
+        have += p.v[i] * p.mass[i];
+        mass += p.mass[i];
+    }
+    let dv = (want - have) / mass;
+    for ((v, x), s) in p.v.iter_mut().zip(&mut p.x).zip(start) {
+        *v += dv;
+        *x = s + *v * dt;
+    }
 }
 
 /// Colours the particles anew when the detection found pairs, so that no two particles of
