@@ -256,10 +256,10 @@ fn keep_momentum(model: &Model, p: &mut Particles, start: &[Vec3], momentum: &[V
     let mut want = Vec3::zeros();
     let mut have = Vec3::zeros();
     let mut mass = 0.0;
-    for i in 0..p.len() {
-        want += momentum[i];
-        have += p.v[i] * p.mass[i];
-        mass += p.mass[i];
+    for ((m, v), target) in p.mass.iter().zip(&p.v).zip(momentum) {
+        want += target;
+        have += v * *m;
+        mass += m;
     }
     let dv = (want - have) / mass;
     for ((v, x), s) in p.v.iter_mut().zip(&mut p.x).zip(start) {
