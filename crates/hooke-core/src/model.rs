@@ -157,6 +157,14 @@ impl Model {
         self.has_contact_responses() || self.surfaces.iter().any(Surface::is_active)
     }
 
+    /// The surfaces with a thickness (whose contacts are on), with their indices.
+    pub(crate) fn active_surfaces(&self) -> impl Iterator<Item = (usize, &Surface)> {
+        self.surfaces
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.is_active())
+    }
+
     /// The contact thickness of particle `p`: its surface's, zero for particles outside
     /// every surface.
     #[inline]

@@ -240,12 +240,7 @@ impl ContactState {
     /// Reads the model's surfaces once: per-particle margins and owners, the primitives.
     fn prepare(&mut self, model: &Model, n: usize) {
         self.ready = true;
-        let active: Vec<_> = model
-            .surfaces
-            .iter()
-            .enumerate()
-            .filter(|(_, s)| s.is_active())
-            .collect();
+        let active: Vec<_> = model.active_surfaces().collect();
         if active.is_empty() {
             return;
         }

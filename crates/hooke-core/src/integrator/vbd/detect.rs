@@ -247,12 +247,7 @@ impl Topology {
             surface: vec![u16::MAX; n],
             ..Self::default()
         };
-        let active: Vec<_> = model
-            .surfaces
-            .iter()
-            .enumerate()
-            .filter(|(_, s)| s.is_active())
-            .collect();
+        let active: Vec<_> = model.active_surfaces().collect();
         for &(k, s) in &active {
             for p in s.particles.clone() {
                 t.surface[p] = k as u16;
@@ -356,6 +351,16 @@ fn within(p: &Vec3, (lo, hi): &(Vec3, Vec3), r: f64) -> bool {
 
 fn boxes_within(a: &(Vec3, Vec3), b: &(Vec3, Vec3), r: f64) -> bool {
     (0..3).all(|k| a.0[k] <= b.1[k] + r && b.0[k] <= a.1[k] + r)
+}
+
+/// Bins `boxes` into `grid` with cells as large as the largest box plus `reach`, so that
+/// everything within `reach` of a query lies in the 27 cells around it ([`by_cell`]).
+fn bin(grid: &mut Grid, boxes: &[(Vec3, Vec3)], reach: f64) {
+    let extent = boxes
+        .iter()
+        .map(|(lo, hi)| (hi - lo).max())
+        .fold(0.0, f64::max);
+    grid.build(extent + reach, boxes.iter().map(|(lo, _)| *lo));
 }
 
 /// Calls `test(q, candidates, out)` for every query `q` whose cell is `cells[q]`, with the
@@ -645,13 +650,7 @@ impl Detection {
             .iter()
             .map(|(t, _)| bounds_of(&t.map(|i| &x[i as usize]).each_ref().map(|p| *p)))
             .collect();
-        let extent = tri_boxes
-            .iter()
-            .map(|(lo, hi)| (hi - lo).max())
-            .fold(0.0, f64::max);
-        let cell = extent + reach;
-        self.triangle_grid
-            .build(cell, tri_boxes.iter().map(|(lo, _)| *lo));
+        bin(&mut self.triangle_grid, &tri_boxes, reach);
         let grid = &self.triangle_grid;
         let at: Vec<Cell> = x.iter().map(|p| grid.cell_of(p)).collect();
         let found = by_cell(grid, &at, |v, candidates, out| {
@@ -706,13 +705,7 @@ impl Detection {
                 )
             })
             .collect();
-        let extent = edge_boxes
-            .iter()
-            .map(|(lo, hi)| (hi - lo).max())
-            .fold(0.0, f64::max);
-        let cell = extent + reach;
-        self.edge_grid
-            .build(cell, edge_boxes.iter().map(|(lo, _)| *lo));
+        bin(&mut self.edge_grid, &edge_boxes, reach);
         let grid = &self.edge_grid;
         let at: Vec<Cell> = edge_boxes.iter().map(|(lo, _)| grid.cell_of(lo)).collect();
         let found = by_cell(grid, &at, |e, candidates, out| {
