@@ -194,6 +194,16 @@ def test_stepping_releases_the_gil_and_a_second_thread_is_told_the_simulation_is
 
 
 def test_ctrl_c_interrupts_a_long_advance_after_a_whole_step():
+    # A job started in the background of a non-interactive shell inherits SIGINT ignored,
+    # and Python then leaves it so: give Ctrl-C its usual meaning for this test.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        ctrl_c_interrupts_a_long_advance()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def ctrl_c_interrupts_a_long_advance():
     sim = hooke.load("cloth-table")
 
     def interrupt_once_stepping():
