@@ -18,9 +18,10 @@
 //! step size: the integrator can fail to converge, never cross.
 
 use super::graph::Graph;
-use crate::collider::Feature;
+use super::pairs::{Pair, Sides, feature_triangle, stencil_distance};
+use super::planes::{Plane, Touches};
 use crate::contact::grid::{Cell, Grid};
-use crate::contact::proximity::{point_triangle, segment_segment, segment_triangle};
+use crate::contact::proximity::{point_triangle, segment_segment};
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
 use crate::response::Response;
@@ -42,84 +43,6 @@ const FELT: f64 = 2.0;
 pub(crate) const CONTACT_STIFFNESS: f64 = 1.0;
 /// Particles (or triangles, edges) per parallel chunk of the detection.
 const CHUNK: usize = 512;
-
-/// What a pair's two sides are.
-#[derive(Clone, Copy, Debug)]
-pub(super) enum Sides {
-    /// Particle `ids[0]` against triangle `ids[1..4]`, which owns the features marked in
-    /// its mask (see [`Topology::owns`]).
-    PointTriangle(u8),
-    /// Edge `ids[0..2]` against edge `ids[2..4]`.
-    EdgeEdge,
-    /// Triangle `ids[0..3]` against the point of a collider's sharp feature nearest it at
-    /// the detection (the feature's tangent, as [`Plane`] is the faces').
-    Feature(Vec3),
-}
-
-/// A contact between two primitives, felt by the particles in `ids`.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Pair {
-    pub(super) sides: Sides,
-    pub(super) ids: [u32; 4],
-    /// The gap kept, metres.
-    pub(super) h: f64,
-    /// Normal stiffness, N/m.
-    pub(super) k: f64,
-    /// Coulomb coefficient (infinite: stick; zero: none).
-    pub(super) mu: f64,
-}
-
-/// The closest points of a pair at `x`: weights `w` on its particles such that
-/// `Σ w_k x_k - anchor` is the gap vector, and whether the pair is the one that counts
-/// that contact. A point nearest a triangle's edge or corner is as near every triangle
-/// sharing it, and two edges nearest at an end are a point against a triangle: such a
-/// contact counts once (the owning triangle's, the point–triangle pair's), so that a
-/// particle over a fold of a mesh does not feel it six times.
-pub(super) fn stencil(pair: &Pair, x: &[Vec3]) -> ([f64; 4], Vec3, usize, bool) {
-    let p = |k: usize| &x[pair.ids[k] as usize];
-    match pair.sides {
-        Sides::PointTriangle(owns) => {
-            let w = point_triangle(p(0), p(1), p(2), p(3));
-            let zeros = w.iter().filter(|&&w| w == 0.0).count();
-            let counts = match zeros {
-                // An edge: the one opposite the zero weight (bits 0..3: ab, bc, ca).
-                1 => {
-                    let edge = match w.iter().position(|&w| w == 0.0) {
-                        Some(2) => 0,
-                        Some(0) => 1,
-                        _ => 2,
-                    };
-                    owns >> edge & 1 == 1
-                }
-                // A corner (bits 3..6).
-                2 => owns >> (3 + w.iter().position(|&w| w != 0.0).unwrap_or(0)) & 1 == 1,
-                _ => true,
-            };
-            ([1.0, -w[0], -w[1], -w[2]], Vec3::zeros(), 4, counts)
-        }
-        Sides::EdgeEdge => {
-            let (s, t) = segment_segment(p(0), p(1), p(2), p(3));
-            let inside = s > 0.0 && s < 1.0 && t > 0.0 && t < 1.0;
-            ([1.0 - s, s, t - 1.0, -t], Vec3::zeros(), 4, inside)
-        }
-        Sides::Feature(anchor) => {
-            let w = point_triangle(&anchor, p(0), p(1), p(2));
-            ([w[0], w[1], w[2], 0.0], anchor, 3, true)
-        }
-    }
-}
-
-/// The point of feature `f` nearest triangle `abc`, and the triangle's weights of its
-/// point nearest to it.
-fn feature_triangle(f: &Feature, a: &Vec3, b: &Vec3, c: &Vec3) -> (Vec3, [f64; 3]) {
-    match f {
-        Feature::Segment([p, q]) => {
-            let (s, w) = segment_triangle(p, q, a, b, c);
-            (p + (q - p) * s, w)
-        }
-        Feature::Circle(circle) => crate::contact::proximity::circle_triangle(circle, a, b, c),
-    }
-}
 
 /// How near a primitive's nearest neighbour is, and its nearest neighbour whose contact is
 /// not felt (farther than [`FELT`] thicknesses), capped at the search's reach.
@@ -154,73 +77,6 @@ impl Clearance {
     /// (`sides` = 2) or not at all (`sides` = 1, a collider).
     fn allows(&self, gamma: f64, h: f64, sides: f64) -> f64 {
         (gamma * self.nearest).min((self.unfelt - h) / sides)
-    }
-}
-
-/// A collider's surface near a particle, as its tangent plane at the last detection: the
-/// iterations measure the particle's gap to it as `normal · (x - point)`, exact for flat
-/// faces and within the bound's reach of exact for curved ones, at the cost of a dot
-/// product instead of a collider query.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Plane {
-    pub(super) collider: u16,
-    pub(super) point: Vec3,
-    pub(super) normal: Vec3,
-}
-
-/// Planes a particle keeps at most (a box's corner and a table's edge need three).
-const TOUCHES: usize = 4;
-
-/// The collider planes one particle may touch, nearest kept when there are more.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Touches {
-    count: u8,
-    planes: [Plane; TOUCHES],
-    gaps: [f64; TOUCHES],
-}
-
-impl Default for Touches {
-    fn default() -> Self {
-        let none = Plane {
-            collider: 0,
-            point: Vec3::zeros(),
-            normal: Vec3::zeros(),
-        };
-        Self {
-            count: 0,
-            planes: [none; TOUCHES],
-            gaps: [f64::INFINITY; TOUCHES],
-        }
-    }
-}
-
-impl Touches {
-    /// The planes.
-    pub(super) fn planes(&self) -> &[Plane] {
-        &self.planes[..self.count as usize]
-    }
-
-    /// Keeps `plane` at gap `d` if there is room or it is nearer than the farthest kept.
-    fn keep(&mut self, plane: Plane, d: f64) {
-        let k = if (self.count as usize) < TOUCHES {
-            self.count += 1;
-            self.count as usize - 1
-        } else {
-            let (far, gap) =
-                self.gaps
-                    .iter()
-                    .enumerate()
-                    .fold(
-                        (0, f64::NEG_INFINITY),
-                        |a, (k, &g)| if g > a.1 { (k, g) } else { a },
-                    );
-            if d >= gap {
-                return;
-            }
-            far
-        };
-        self.planes[k] = plane;
-        self.gaps[k] = d;
     }
 }
 
@@ -862,14 +718,4 @@ impl Detection {
         self.scratch_own = own;
         self.scratch_allowed = allowed;
     }
-}
-
-/// The length of a pair's gap at `x`.
-fn stencil_distance(pair: &Pair, x: &[Vec3]) -> f64 {
-    let (w, anchor, len, _) = stencil(pair, x);
-    let mut g = -anchor;
-    for k in 0..len {
-        g += x[pair.ids[k] as usize] * w[k];
-    }
-    g.norm()
 }

@@ -1,8 +1,9 @@
 //! One particle's block update: a Newton step on its share of the implicit-Euler energy,
 //! the others held where they are (docs/physics.md §4.1).
 
-use super::detect::{Detection, collider_law, stencil};
+use super::detect::{Detection, collider_law};
 use super::graph::Graph;
+use super::pairs::stencil;
 use crate::integrator::Sym3;
 use crate::model::Model;
 use crate::particles::Vec3;

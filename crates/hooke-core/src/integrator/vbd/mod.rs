@@ -18,6 +18,8 @@
 mod detect;
 mod graph;
 mod local;
+mod pairs;
+mod planes;
 
 use super::{StepReport, Workspace};
 use crate::model::Model;
