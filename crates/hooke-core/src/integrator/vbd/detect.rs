@@ -97,6 +97,14 @@ struct Topology {
 }
 
 impl Topology {
+    /// The thickness particle `i` keeps: its active surface's, zero outside every one.
+    fn margin(&self, model: &Model, i: usize) -> f64 {
+        match self.surface[i] {
+            u16::MAX => 0.0,
+            s => model.surfaces[s as usize].thickness,
+        }
+    }
+
     fn new(model: &Model, n: usize) -> Self {
         let mut t = Self {
             built_for: n,
@@ -171,8 +179,7 @@ pub(super) struct Detection {
     scratch_collider: Vec<Clearance>,
     scratch_own: Vec<Clearance>,
     scratch_allowed: Vec<f64>,
-    /// Each surface's thickness, and the largest of the active ones.
-    thickness: Vec<f64>,
+    /// The largest thickness of the active surfaces.
     h_max: f64,
     /// Per particle: its stiffness scale `m/dt² + Σ ks`.
     pub(super) scale: Vec<f64>,
@@ -300,10 +307,7 @@ impl Detection {
     /// The thickness particle `i` keeps from colliders.
     #[inline]
     pub(super) fn margin(&self, model: &Model, i: usize) -> f64 {
-        match self.topology.surface[i] {
-            u16::MAX => 0.0,
-            s => model.surfaces[s as usize].thickness,
-        }
+        self.topology.margin(model, i)
     }
 
     /// Detects at positions `x` (the current iterate), with `y` the step's inertial targets
@@ -324,14 +328,9 @@ impl Detection {
         self.scale.clear();
         self.scale
             .extend((0..n).map(|i| p.mass[i] / (dt * dt) + graph.stiffness[i]));
-        self.thickness.clear();
-        self.thickness
-            .extend(model.surfaces.iter().map(|s| s.thickness));
         let h_max = model
-            .surfaces
-            .iter()
-            .filter(|s| s.is_active())
-            .map(|s| s.thickness)
+            .active_surfaces()
+            .map(|(_, s)| s.thickness)
             .fold(0.0, f64::max);
         self.h_max = h_max;
         let travel = (0..n)
@@ -344,7 +343,7 @@ impl Detection {
         let surface_reach = SURFACE_REACH * h_max;
         self.detect_surfaces(model, x, surface_reach);
         self.index_pairs(n, p);
-        self.set_bounds(p, (x, y));
+        self.set_bounds(model, p, (x, y));
     }
 
     /// Per particle: the nearest collider surface (capped at `reach`) and which colliders
@@ -355,10 +354,7 @@ impl Detection {
         self.point_collider.resize(n, Clearance::new(reach));
         self.touches.resize(n, Touches::default());
         let one = |i: usize, clearance: &mut Clearance, near: &mut Touches| {
-            let margin = match topology.surface[i] {
-                u16::MAX => 0.0,
-                s => model.surfaces[s as usize].thickness,
-            };
+            let margin = topology.margin(model, i);
             let (lo, hi) = (x[i].add_scalar(-reach), x[i].add_scalar(reach));
             *clearance = Clearance::new(reach);
             *near = Touches::default();
@@ -643,7 +639,7 @@ impl Detection {
     }
 
     /// Each particle's ball: the shared translation `u` and the radii (see the module docs).
-    fn set_bounds(&mut self, p: &Particles, (x, y): (&[Vec3], &[Vec3])) {
+    fn set_bounds(&mut self, model: &Model, p: &Particles, (x, y): (&[Vec3], &[Vec3])) {
         let n = x.len();
         let topo = &self.topology;
         // Nearest collider of each particle, its triangles' features included.
@@ -666,10 +662,7 @@ impl Detection {
             }
         }
         let h_max = self.h_max;
-        let margin = |i: usize| match topo.surface[i] {
-            u16::MAX => 0.0,
-            s => self.thickness[s as usize],
-        };
+        let margin = |i: usize| topo.margin(model, i);
         let mut allowed = std::mem::take(&mut self.scratch_allowed);
         allowed.clear();
         allowed.extend((0..n).map(|i| collider[i].allows(GAMMA_COLLIDER, margin(i), 1.0)));
