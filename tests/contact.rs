@@ -4,7 +4,8 @@
 //! independent of the solver's proximity code.
 
 use crate::common::{builtin, root};
-use hooke_cli::export::obj::ObjExport;
+use hooke::Sink;
+use hooke::export::obj::ObjExport;
 use hooke_core::{Integrator, Model, Particles, Simulation, Surface, Vec3, contact::ContactStats};
 use hooke_scene::Overrides;
 use std::path::{Path, PathBuf};

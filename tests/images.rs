@@ -14,8 +14,8 @@
 //! goldens. With `CI` set (or `INSTA_UPDATE=no`) nothing is written, only compared.
 
 use crate::common::root;
-use hooke_cli::image_out::View;
-use hooke_cli::stills::{still_scene, still_view};
+use hooke::image_out::View;
+use hooke::stills::{still_scene, still_view};
 use hooke_scene::Overrides;
 use image::{Rgba, RgbaImage};
 use std::path::{Path, PathBuf};
@@ -147,12 +147,11 @@ fn stills_match_the_golden_images() {
     }
     // A jello world drawn as springs: box edges, the inclined plane and the three families.
     let world = root().join("assets/worlds/rotate.w");
-    let mut scene =
-        hooke_cli::source::build(world.to_str().unwrap(), &Overrides::default()).unwrap();
+    let mut scene = hooke::source::build(world.to_str().unwrap(), &Overrides::default()).unwrap();
     let steps = scene.steps;
     scene.simulation.advance(steps).unwrap();
     let springs = View {
-        style: hooke_cli::draw::Style::Springs,
+        style: hooke::draw::Style::Springs,
         ..view()
     };
     let image = springs.pixels(&scene, &springs.camera(&scene));

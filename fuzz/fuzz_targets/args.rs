@@ -22,12 +22,12 @@ fuzz_target!(|data: &[u8]| {
     if !args.iter().any(|a| a == "--size") {
         args.extend(["--size".to_string(), "64x48".to_string()]);
     }
-    if let Ok(image) = hooke_cli::image_out::picture_from_args(&args, 200) {
+    if let Ok(image) = hooke_cli::args::picture_from_args(&args, 200) {
         let size = args
             .iter()
             .rposition(|a| a == "--size")
             .and_then(|i| args.get(i + 1))
-            .and_then(|s| hooke_cli::image_out::parse_size(s).ok());
+            .and_then(|s| hooke_cli::args::parse_size(s).ok());
         if let Some((w, h)) = size {
             assert_eq!(image.dimensions(), (w, h));
         }

@@ -5,10 +5,10 @@
 //!
 //! The Python half (`hooke/__init__.py`) re-exports this and adds `sweep`.
 
-use hooke_cli::export::{Exporter, FolderFormat, Target};
-use hooke_cli::image_out::View;
-use hooke_cli::{driver, source};
-use hooke_core::{Divergence, Integrator, Vec3};
+use hooke::export::{FolderFormat, Target};
+use hooke::image_out::View;
+use hooke::{driver, source};
+use hooke_core::{Integrator, Vec3};
 use hooke_scene::{Overrides, Scene};
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::create_exception;
@@ -58,12 +58,11 @@ fn in_python_terms(message: &str) -> String {
 
 /// A Rust error as the Python exception that says the same as the command would, in the
 /// terms of the Python call.
-fn error(e: anyhow::Error) -> PyErr {
-    let message = in_python_terms(&format!("{e:#}"));
-    if e.chain().any(|c| c.downcast_ref::<Divergence>().is_some()) {
-        DivergenceError::new_err(message)
-    } else {
-        HookeError::new_err(message)
+fn error(e: hooke::Error) -> PyErr {
+    let message = in_python_terms(&e.to_string());
+    match e {
+        hooke::Error::Diverged { .. } => DivergenceError::new_err(message),
+        _ => HookeError::new_err(message),
     }
 }
 
@@ -145,7 +144,7 @@ impl Inner {
                             break;
                         }
                     }
-                    Ok::<u64, Divergence>(done)
+                    Ok::<u64, hooke_core::Divergence>(done)
                 })
             });
             left -= done.map_err(|e| error(e.into()))?;
@@ -399,11 +398,11 @@ impl Simulation {
         };
         let target = Target::new(Path::new(path), format, body).map_err(error)?;
         // No export replaces a file the simulation was built from.
-        let mut claims = hooke_cli::output::claims::Claims::with_inputs(self.inputs.clone());
+        let mut claims = hooke::output::claims::Claims::with_inputs(self.inputs.clone());
         target.claim(&mut claims);
         claims.check().map_err(error)?;
         let mut inner = self.lock()?;
-        let mut exporter = Exporter::create(&target, &inner.scene).map_err(error)?;
+        let mut exporter = hooke::export::create(&target, &inner.scene).map_err(error)?;
         let left = inner
             .scene
             .steps
@@ -520,7 +519,7 @@ fn load(
             let key: String = key.extract()?;
             read.spec
                 .set(&key, toml_value(&value)?)
-                .map_err(|e| error(anyhow::Error::new(e).context(format!("scene '{source}'"))))?;
+                .map_err(|e| error(hooke::Error::from(e).context(format!("scene '{source}'"))))?;
         }
     }
     let threads = threads
@@ -529,10 +528,10 @@ fn load(
     let pool = match threads {
         None => {
             // rayon's global pool reads RAYON_NUM_THREADS: bounded like `threads`.
-            hooke_cli::threads::from_environment().map_err(error)?;
+            hooke::threads::from_environment().map_err(error)?;
             None
         }
-        Some(n) => Some(hooke_cli::threads::pool(Some(n), "threads").map_err(error)?),
+        Some(n) => Some(hooke::threads::pool(Some(n), "threads").map_err(error)?),
     };
     let prepared = source::prepare(read, source, &overrides).map_err(error)?;
     let inputs = prepared.inputs();

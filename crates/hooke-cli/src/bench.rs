@@ -89,7 +89,7 @@ pub enum Bench {
         #[arg(long, value_name = "DIR")]
         save: Option<std::path::PathBuf>,
         /// Image size.
-        #[arg(long, default_value = "1024x1024", value_parser = crate::image_out::parse_size)]
+        #[arg(long, default_value = "1024x1024", value_parser = hooke_cli::args::parse_size)]
         size: (u32, u32),
         /// Samples per pixel along each axis, 1 to 4 (2 = 4× anti-aliasing).
         #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=4))]
@@ -192,7 +192,7 @@ impl StepTimes {
         let mut untimed = std::time::Duration::ZERO;
         for _ in 0..steps {
             // An atomic load per step: far below the timer reads around it.
-            hooke_cli::interrupt::check(simulation)?;
+            hooke::interrupt::check(simulation)?;
             simulation.step()?;
             let now = Instant::now();
             after(simulation);
@@ -258,7 +258,7 @@ struct RenderFigures {
 }
 
 fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
-    hooke_cli::threads::pool(threads, "--threads")
+    Ok(hooke::threads::pool(threads, "--threads")?)
 }
 
 fn workload(n: usize, steps: u64, integrator: Integrator, air: bool) -> Result<Scene> {
@@ -567,7 +567,7 @@ fn renders(
             None => {
                 let mut scene = source::build(target, &Overrides::default())?;
                 let steps = scene.steps;
-                hooke_cli::driver::advance(&mut scene, steps)?;
+                hooke::driver::advance(&mut scene, steps)?;
                 scene
             }
         };
@@ -595,7 +595,7 @@ fn renders(
             let name = Path::new(name.as_str())
                 .file_stem()
                 .map_or_else(|| name.clone(), |s| s.to_string_lossy().into_owned());
-            crate::image_out::write_png(&dir.join(format!("{name}.png")), &image)?;
+            hooke::image_out::write_png(&dir.join(format!("{name}.png")), &image)?;
         }
         let mut encode = Vec::new();
         for _ in 0..repeat {

@@ -5,12 +5,13 @@
 mod bench;
 mod picture;
 mod run;
-mod trajectory;
+#[cfg(feature = "view")]
 mod view;
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
-use hooke_cli::{draw, image_out, output, source};
+use hooke::{draw, output, source};
+use hooke_cli::args::ViewArgs;
 use hooke_core::Integrator;
 use hooke_scene::Overrides;
 use std::path::PathBuf;
@@ -38,7 +39,7 @@ enum Command {
         #[arg(long, default_value = "out")]
         out: PathBuf,
         #[command(flatten)]
-        view: image_out::View,
+        view: ViewArgs,
     },
     /// List the built-in scenes.
     Scenes,
@@ -55,6 +56,7 @@ enum Command {
         setup: SetupArgs,
     },
     /// Show scenes live in a window (TAB cycles, R replays, drag rotates, SHIFT+drag zooms).
+    #[cfg(feature = "view")]
     View(view::ViewArgs),
     /// Benchmarks: the cloth-N solver workload and the rasterizer.
     #[command(subcommand)]
@@ -116,7 +118,7 @@ impl SetupArgs {
         let table = self
             .table
             .as_deref()
-            .map(hooke_cli::source::table)
+            .map(hooke::source::table)
             .transpose()?;
         Ok(Overrides {
             integrator: self.integrator,
@@ -157,12 +159,12 @@ struct RunArgs {
     export: Option<PathBuf>,
     /// The files of a folder export: ply (binary, with normals) or obj (with colliders).
     #[arg(long, requires = "export")]
-    format: Option<hooke_cli::export::FolderFormat>,
+    format: Option<hooke::export::FolderFormat>,
     /// The body a .pc2 export caches (default: the scene's first).
     #[arg(long, value_name = "NAME", requires = "export")]
     body: Option<String>,
     #[command(flatten)]
-    view: image_out::View,
+    view: ViewArgs,
 }
 
 #[derive(Args)]
@@ -178,7 +180,7 @@ struct RenderArgs {
     #[command(flatten)]
     setup: SetupArgs,
     #[command(flatten)]
-    view: image_out::View,
+    view: ViewArgs,
 }
 
 /// Leaves quietly, as a Unix filter does, when the reader of standard output has gone
@@ -199,27 +201,31 @@ fn quiet_on_closed_pipe() {
 fn main() -> ExitCode {
     quiet_on_closed_pipe();
     let cli = Cli::parse();
-    hooke_cli::interrupt::install();
+    hooke::interrupt::install();
+    hooke::progress::install(Box::new(hooke_cli::bars::Bars));
     // Everything but the window runs on a worker of the thread pool: the solver's parallel
     // loops are then cheap joins, not injections that wake the pool through the kernel on
     // every call (the 512-particle jelly steps about 1.6× faster so). The viewer keeps the
     // main thread, as windowing systems prefer, and `bench` builds its own pool (one pool
     // waiting inside another would spin on a core the measured one needs).
     let result = match cli.command {
-        Command::View(_) | Command::Bench(_) => dispatch(cli.command),
+        #[cfg(feature = "view")]
+        Command::View(_) => dispatch(cli.command),
+        Command::Bench(_) => dispatch(cli.command),
         // A bad RAYON_NUM_THREADS is refused; a pool that cannot start leaves the work here.
-        command => hooke_cli::threads::count(None, "--threads").and_then(|count| {
-            match hooke_cli::threads::build(count) {
+        command => match hooke::threads::count(None, "--threads") {
+            Ok(count) => match hooke::threads::build(count) {
                 Ok(pool) => pool.install(|| dispatch(command)),
                 Err(_) => dispatch(command),
-            }
-        }),
+            },
+            Err(e) => Err(e.into()),
+        },
     };
     match result {
         Ok(code) => code,
-        Err(e) if hooke_cli::interrupt::is_interrupt(&e) => {
+        Err(e) if e.downcast_ref().is_some_and(hooke::interrupt::is_interrupt) => {
             eprintln!("{e:#}: stopped");
-            ExitCode::from(hooke_cli::interrupt::EXIT_INTERRUPTED)
+            ExitCode::from(hooke::interrupt::EXIT_INTERRUPTED)
         }
         Err(e) => {
             eprintln!("error: {e:#}");
@@ -232,7 +238,7 @@ fn dispatch(command: Command) -> Result<ExitCode> {
     match command {
         Command::Run(args) => run::run(&args),
         Command::Render(args) => picture::render(&args),
-        Command::Demo { out, view } => picture::demo(&out, &view),
+        Command::Demo { out, view } => picture::demo(&out, &view.view()),
         Command::Scenes => {
             for (name, make) in hooke_scene::builtin::BUILTINS {
                 println!("{name:<14} {}", make().description);
@@ -247,6 +253,7 @@ fn dispatch(command: Command) -> Result<ExitCode> {
         Command::Check { scene, setup } => run::check(&scene, &setup),
         Command::Convert { input, output } => run::convert(&input, &output),
         Command::Bench(bench) => bench::run(&bench),
+        #[cfg(feature = "view")]
         Command::View(args) => view::run(&args),
     }
 }

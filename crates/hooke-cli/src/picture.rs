@@ -1,15 +1,14 @@
 //! `hooke render` and `hooke demo`.
 
 use crate::RenderArgs;
-use crate::image_out::{GifWriter, View, write_png};
-use crate::source;
 use anyhow::{Context, Result};
-use hooke_cli::driver::{advance, drive, steps_to};
-use hooke_cli::output::{check_output_file, check_output_folder, frame_name, prepare_frame_folder};
-use hooke_cli::stills::{still_scene, still_view};
+use hooke::driver::{advance, drive, steps_to};
+use hooke::image_out::{GifWriter, View, write_png};
+use hooke::output::{check_output_file, check_output_folder};
+use hooke::source;
+use hooke::stills::{still_scene, still_view};
 use hooke_core::Num;
 use hooke_scene::Overrides;
-use hooke_scene::Scene;
 use hooke_scene::builtin::BUILTINS;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -25,7 +24,7 @@ pub fn render(args: &RenderArgs) -> Result<ExitCode> {
         &args.scene,
         &args.setup.overrides()?,
     )?;
-    let mut claims = hooke_cli::output::claims::Claims::with_inputs(source.inputs());
+    let mut claims = hooke::output::claims::Claims::with_inputs(source.inputs());
     claims.file("-o", &args.output);
     claims.check()?;
     let mut scene = source::build_prepared(source, &args.scene)?;
@@ -40,8 +39,9 @@ pub fn render(args: &RenderArgs) -> Result<ExitCode> {
         );
     }
     advance(&mut scene, steps)?;
-    let camera = args.view.camera(&scene);
-    write_png(&args.output, &args.view.pixels(&scene, &camera))?;
+    let view = args.view.view();
+    let camera = view.camera(&scene);
+    write_png(&args.output, &view.pixels(&scene, &camera))?;
     eprintln!(
         "{}: t = {} s -> {}",
         scene.spec.name,
@@ -59,7 +59,7 @@ pub fn demo(out: &Path, view: &View) -> Result<ExitCode> {
     std::fs::create_dir_all(out)
         .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
     // Two demos writing one folder would mix their stills.
-    let _held = hooke_cli::output::lock::FolderLock::take(out, "--out")?;
+    let _held = hooke::output::lock::FolderLock::take(out, "--out")?;
     let mut written: Vec<PathBuf> = Vec::new();
     for (k, (name, _)) in BUILTINS.iter().enumerate() {
         let started = Instant::now();
@@ -97,7 +97,7 @@ fn animate(
     view: &View,
 ) -> Result<PathBuf> {
     let mut scene = source::build(name, &Overrides::default())?;
-    scene.every = hooke_cli::driver::steps_for(&scene, interval).max(1);
+    scene.every = hooke::driver::steps_for(&scene, interval).max(1);
     let small = View {
         size: (view.size.0 / 2, view.size.1 / 2),
         supersample: 1,
@@ -110,11 +110,7 @@ fn animate(
     });
     let count = gif.frames();
     // Interrupted, the animation still ends at its last whole frame, as a run's GIF does.
-    if result.is_ok()
-        || result
-            .as_ref()
-            .is_err_and(hooke_cli::interrupt::is_interrupt)
-    {
+    if result.is_ok() || result.as_ref().is_err_and(hooke::interrupt::is_interrupt) {
         gif.finish()?;
     }
     result?;
@@ -123,81 +119,4 @@ fn animate(
         path.display()
     );
     Ok(path)
-}
-
-/// Writes frames of a run as numbered PNGs and optionally a GIF, each as it comes.
-pub struct FrameSink {
-    dir: Option<PathBuf>,
-    /// The frame folder, held for this run.
-    _lock: Option<hooke_cli::output::lock::FolderLock>,
-    gif: Option<GifWriter>,
-    view: View,
-    camera: Option<hooke_render::Camera>,
-}
-
-impl FrameSink {
-    /// Prepares the outputs before a run (whose paths `run` has checked before building the
-    /// scene): the frame folder is created and cleared of an earlier run's frames, the GIF
-    /// started.
-    pub fn new(
-        dir: Option<PathBuf>,
-        gif: Option<PathBuf>,
-        view: View,
-        frame_seconds: f64,
-    ) -> Result<Option<Self>> {
-        if dir.is_none() && gif.is_none() {
-            return Ok(None);
-        }
-        let mut lock = None;
-        if let Some(d) = &dir {
-            let (held, removed) = prepare_frame_folder(d, "--frames", "png")?;
-            lock = Some(held);
-            if removed > 0 {
-                eprintln!(
-                    "--frames: removed {removed} frame{} of an earlier run from {}",
-                    if removed == 1 { "" } else { "s" },
-                    d.display()
-                );
-            }
-        }
-        let gif = match &gif {
-            Some(path) => {
-                let frame_ms = (frame_seconds * 1000.0).round().clamp(10.0, 655_350.0) as u32;
-                Some(GifWriter::create(path, view.size, frame_ms)?)
-            }
-            None => None,
-        };
-        Ok(Some(Self {
-            dir,
-            _lock: lock,
-            gif,
-            view,
-            camera: None,
-        }))
-    }
-
-    /// Draws one frame; the camera is fixed by the first frame, with room for motion.
-    pub fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
-        let camera = *self.camera.get_or_insert_with(|| {
-            let mut c = self.view.camera(scene);
-            c.distance *= 1.3;
-            c
-        });
-        let image = self.view.pixels(scene, &camera);
-        if let Some(d) = &self.dir {
-            write_png(&d.join(frame_name(frame, "png")), &image)?;
-        }
-        if let Some(g) = self.gif.as_mut() {
-            g.frame(image)?;
-        }
-        Ok(())
-    }
-
-    /// Puts the GIF in place.
-    pub fn finish(self) -> Result<()> {
-        match self.gif {
-            Some(g) => g.finish(),
-            None => Ok(()),
-        }
-    }
 }

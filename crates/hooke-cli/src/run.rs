@@ -1,22 +1,22 @@
 //! `hooke run`, `hooke check` and `hooke convert`.
 
-use crate::source;
-use crate::trajectory::TrajectoryWriter;
 use crate::{RunArgs, SetupArgs};
 use anyhow::{Context, Result, bail};
-use hooke_cli::driver::drive;
-use hooke_cli::export::{Exporter, Target};
-use hooke_cli::interrupt::{self, is_interrupt};
-use hooke_cli::output::claims::Claims;
-use hooke_cli::output::{check_output_file, check_output_folder};
+use hooke::export::Target;
+use hooke::frames::Frames;
+use hooke::interrupt::{self, is_interrupt};
+use hooke::output::claims::Claims;
+use hooke::output::{check_output_file, check_output_folder};
+use hooke::trajectory::TrajectoryWriter;
+use hooke::{Sink, record, source};
 use hooke_core::Num;
-use hooke_core::{Divergence, Integrator, StabilityEstimate, Summary};
+use hooke_core::{Integrator, StabilityEstimate, Summary};
 use hooke_scene::{Overrides, Scene};
 use std::path::Path;
 use std::process::ExitCode;
 
-fn is_divergence(e: &anyhow::Error) -> bool {
-    e.downcast_ref::<Divergence>().is_some()
+fn is_divergence(e: &hooke::Error) -> bool {
+    matches!(e, hooke::Error::Diverged { .. })
 }
 
 /// Warns on stderr when the scene's step exceeds the estimated stable step.
@@ -234,11 +234,6 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
     let mut scene = source::build_prepared(source, &args.scene)?;
     warn_if_unstable(&scene);
     warn_if_tunnelling(&scene);
-    let mut trajectory = args
-        .trajectory
-        .as_deref()
-        .map(TrajectoryWriter::create)
-        .transpose()?;
     let every = scene.every;
     let dt = scene.simulation.dt();
     if args.summary {
@@ -254,26 +249,28 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
             "max depth"
         );
     }
-    let mut frames = crate::picture::FrameSink::new(
+    // The outputs in the order they are finished: the trajectory, the pictures, the export.
+    let mut sinks: Vec<Box<dyn Sink>> = Vec::new();
+    if let Some(path) = &args.trajectory {
+        sinks.push(Box::new(TrajectoryWriter::create(path)?));
+    }
+    if let Some(frames) = Frames::new(
         args.frames.clone(),
         args.gif.clone(),
-        args.view.clone(),
+        args.view.view(),
         every as f64 * dt,
-    )?;
-    let mut export = export_target
-        .map(|target| Exporter::create(&target, &scene))
-        .transpose()?;
-    let result = drive(&mut scene, |frame, scene| {
-        if let Some(e) = export.as_mut() {
-            e.frame(frame, scene)?;
-        }
-        let sim = &scene.simulation;
-        // docs/physics.md §6: the time of frame f is (f K) dt computed as one product.
-        let time = (frame * every) as f64 * dt;
-        if let Some(t) = trajectory.as_mut() {
-            t.frame(frame, time, sim.particles())?;
-        }
+    )? {
+        sinks.push(Box::new(frames));
+    }
+    let exporting = export_target.is_some();
+    if let Some(target) = &export_target {
+        sinks.push(hooke::export::create(target, &scene)?);
+    }
+    let result = record(&mut scene, sinks, |frame, scene| {
         if args.summary {
+            let sim = &scene.simulation;
+            // docs/physics.md §6: the time of frame f is (f K) dt computed as one product.
+            let time = (frame * every) as f64 * dt;
             let s = Summary::of(sim.model(), sim.particles());
             let v = |v: hooke_core::Vec3| format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z);
             println!(
@@ -286,24 +283,19 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
                 s.max_penetration
             );
         }
-        if let Some(f) = frames.as_mut() {
-            f.frame(frame, scene)?;
-        }
         Ok(())
     });
-    // After a divergence or Ctrl-C the frames already written are complete and are kept.
-    let kept = |e: &anyhow::Error| is_divergence(e) || is_interrupt(e);
-    if result.is_ok() || result.as_ref().is_err_and(kept) {
-        if let Some(t) = trajectory {
-            t.finish()?;
+    // After a divergence or Ctrl-C the frames already written are complete and were kept.
+    let result = result.map(|recording| {
+        if exporting && let Some(written) = recording.written.last() {
+            eprintln!("export: {written}");
         }
-        if let Some(f) = frames {
-            f.finish()?;
-        }
-        if let Some(e) = export {
-            eprintln!("export: {}", e.finish()?);
-        }
-    }
+        recording.stopped
+    });
+    let result = match result {
+        Ok(None) => Ok(()),
+        Ok(Some(e)) | Err(e) => Err(e),
+    };
     if let Err(e) = &result
         && is_interrupt(e)
     {
@@ -327,7 +319,8 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
                  much as stiff springs do"
             )),
             _ => e,
-        });
+        }
+        .into());
     }
     let sim = &scene.simulation;
     eprintln!(

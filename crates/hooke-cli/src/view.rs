@@ -7,11 +7,11 @@
 //! then the scene is drawn and the overlay written on top.
 
 use crate::draw::{DEFAULT_YAW_PITCH, Style, draw_with, frame_camera};
-use crate::image_out::write_png;
 use crate::source;
 use anyhow::{Context, Result};
 use font8x8::UnicodeFonts;
-use hooke_cli::{driver, interrupt};
+use hooke::image_out::write_png;
+use hooke::{driver, interrupt};
 use hooke_core::{Air, Attachment, SpringKind, Vec3};
 use hooke_render::{Camera, RenderOptions, Renderer};
 use hooke_scene::{Overrides, Scene};
@@ -29,7 +29,7 @@ pub struct ViewArgs {
     /// (default: the seven built-ins).
     scenes: Vec<String>,
     /// Window size as WIDTHxHEIGHT.
-    #[arg(long, default_value = "800x600", value_parser = crate::image_out::parse_size)]
+    #[arg(long, default_value = "800x600", value_parser = hooke_cli::args::parse_size)]
     size: (u32, u32),
     /// Samples per pixel along each axis, 1 to 4 (1 = fastest, 2 = 4× anti-aliasing).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4))]
@@ -318,7 +318,7 @@ impl Viewer {
             .collect();
         let result = RgbaImage::from_raw(size.0, size.1, pixels)
             .context("frame size")
-            .and_then(|image| write_png(&path, &image));
+            .and_then(|image| Ok(write_png(&path, &image)?));
         match result {
             Ok(()) => eprintln!("screenshot: {}", path.display()),
             Err(e) => eprintln!("screenshot failed: {e:#}"),
@@ -385,7 +385,7 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
     window.set_target_fps(0);
     let mut viewer = Viewer::new(scenes, overrides)?;
     let mut renderer = Renderer::default();
-    let pool = hooke_cli::threads::pool(None, "--threads")?;
+    let pool = hooke::threads::pool(None, "--threads")?;
     let mut buffer = vec![0u32; w * h];
     let options = viewer.options(size, args.supersample);
 

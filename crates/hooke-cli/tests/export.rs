@@ -228,7 +228,7 @@ fn a_point_cache_matches_the_trajectory_and_its_mesh_loads_with_tobj() {
 
 #[test]
 fn ply_frames_read_back_with_the_ply_crate() {
-    use hooke_cli::export::ply::{PlyFace, PlyVertex};
+    use hooke::export::ply::{PlyFace, PlyVertex};
     use ply_rs_bw::parser::Parser;
     let dir = scratch("export-ply");
     let said = run(

@@ -461,7 +461,7 @@ fn frame_folders_plurals_table_paths_and_tiny_numbers() {
 }
 
 mod picture_arguments {
-    use hooke_cli::image_out::{parse_size, picture_from_args};
+    use hooke_cli::args::{parse_size, picture_from_args};
     use proptest::prelude::*;
 
     const OPTIONS: [&str; 7] = [

@@ -3,7 +3,7 @@
 //! however it exits. The file names the holder (process id and command) for the message a
 //! second run gets.
 
-use anyhow::{Context, Result, bail};
+use crate::error::{Context, Result, bail_output};
 use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::os::unix::fs::MetadataExt;
@@ -79,7 +79,7 @@ impl Held {
                     let mut said = String::new();
                     let _ = file.read_to_string(&mut said);
                     let said = said.trim();
-                    bail!(
+                    bail_output!(
                         "{flag} {}: the folder is being written by another run, {}; wait for it \
                          to end or choose another folder",
                         dir.display(),
@@ -109,7 +109,7 @@ impl Held {
                 .with_context(|| format!("{flag} {}: cannot write {LOCK_NAME}", dir.display()))?;
             return Ok(Self { path, file });
         }
-        bail!(
+        bail_output!(
             "{flag} {}: cannot lock the folder (its lock file keeps changing)",
             dir.display()
         )

@@ -15,16 +15,18 @@
 pub mod obj;
 pub mod pc2;
 pub mod ply;
+#[cfg(feature = "export-usd")]
 pub mod usd;
 
+use crate::error::{Result, bail_output};
 use crate::output::{check_output_file, check_output_folder};
-use anyhow::{Result, bail};
 use hooke_core::Vec3;
 use hooke_scene::{Body, ColliderGeometry, Scene, Topology};
 use std::path::{Path, PathBuf};
 
 /// The format of a folder export (`--format`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum FolderFormat {
     /// Binary little-endian PLY: vertices with normals, triangles.
     Ply,
@@ -68,7 +70,7 @@ impl Target {
     /// what was expected when the combination makes no sense or the path cannot be written.
     ///
     /// ```
-    /// use hooke_cli::export::{FolderFormat, Target};
+    /// use hooke::export::{FolderFormat, Target};
     /// use std::path::Path;
     /// let dir = std::env::temp_dir();
     /// let usd = dir.join("run.usda");
@@ -97,11 +99,11 @@ impl Target {
                     format,
                 }
             }
-            (true, _, None) => bail!(
+            (true, _, None) => bail_output!(
                 "--export {}: a folder export needs --format ply or --format obj",
                 path.display()
             ),
-            (false, "usda" | "pc2", Some(format)) => bail!(
+            (false, "usda" | "pc2", Some(format)) => bail_output!(
                 "--format {}: only folder exports (--export DIR/) take a format; {} is a .{ext} \
                  file",
                 format.extension(),
@@ -113,7 +115,7 @@ impl Target {
             }
             (false, "pc2", None) => {
                 if check_output_file(path, "--export", &["pc2"])?.is_stream() {
-                    bail!(
+                    bail_output!(
                         "--export {}: a point cache is written with its sample count at the \
                          start, known only at the end: it needs a regular file, not a stream",
                         path.display()
@@ -125,14 +127,14 @@ impl Target {
                     body: body.map(str::to_string),
                 }
             }
-            _ => bail!(
+            _ => bail_output!(
                 "--export {}: expected a file ending in .usda or .pc2, or a folder ending in / \
                  with --format ply or obj",
                 path.display()
             ),
         };
         if body.is_some() && !matches!(target, Target::Pc2 { .. }) {
-            bail!("--body: only a .pc2 export holds one body; the others hold them all");
+            bail_output!("--body: only a .pc2 export holds one body; the others hold them all");
         }
         Ok(target)
     }
@@ -150,56 +152,28 @@ impl Target {
     }
 }
 
-/// An export being written.
-pub enum Exporter {
-    /// A USD stage.
-    Usd(usd::UsdExport),
-    /// A point cache.
-    Pc2(pc2::Pc2Export),
-    /// OBJ frames.
-    Obj(obj::ObjExport),
-    /// PLY frames.
-    Ply(ply::PlyExport),
-}
-
-impl Exporter {
-    /// Starts exporting `scene` to `target`.
-    pub fn create(target: &Target, scene: &Scene) -> Result<Self> {
-        Ok(match target {
-            Target::Usd(path) => Self::Usd(usd::UsdExport::create(path, scene)?),
-            Target::Pc2 { path, body } => {
-                Self::Pc2(pc2::Pc2Export::create(path, body.as_deref(), scene)?)
-            }
-            Target::Folder {
-                dir,
-                format: FolderFormat::Obj,
-            } => Self::Obj(obj::ObjExport::new(dir, scene)?),
-            Target::Folder {
-                dir,
-                format: FolderFormat::Ply,
-            } => Self::Ply(ply::PlyExport::new(dir, scene)?),
-        })
-    }
-
-    /// Writes frame `frame`: `scene` at its current state.
-    pub fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
-        match self {
-            Self::Usd(e) => e.frame(frame, scene),
-            Self::Pc2(e) => e.frame(frame, scene),
-            Self::Obj(e) => e.frame(frame, scene),
-            Self::Ply(e) => e.frame(frame, scene),
+/// Starts exporting `scene` to `target`.
+pub fn create(target: &Target, scene: &Scene) -> Result<Box<dyn crate::Sink + Send>> {
+    Ok(match target {
+        #[cfg(feature = "export-usd")]
+        Target::Usd(path) => Box::new(usd::UsdExport::create(path, scene)?),
+        #[cfg(not(feature = "export-usd"))]
+        Target::Usd(path) => crate::error::bail_output!(
+            "--export {}: this build of hooke has no USD export (feature `export-usd`)",
+            path.display()
+        ),
+        Target::Pc2 { path, body } => {
+            Box::new(pc2::Pc2Export::create(path, body.as_deref(), scene)?)
         }
-    }
-
-    /// Finishes the files with the frames written so far, and says what was written.
-    pub fn finish(self) -> Result<String> {
-        match self {
-            Self::Usd(e) => e.finish(),
-            Self::Pc2(e) => e.finish(),
-            Self::Obj(e) => Ok(e.summary()),
-            Self::Ply(e) => Ok(e.summary()),
-        }
-    }
+        Target::Folder {
+            dir,
+            format: FolderFormat::Obj,
+        } => Box::new(obj::ObjExport::new(dir, scene)?),
+        Target::Folder {
+            dir,
+            format: FolderFormat::Ply,
+        } => Box::new(ply::PlyExport::new(dir, scene)?),
+    })
 }
 
 /// Prepares `dir` for a folder export's `frame-NNNNN.ext` files (see

@@ -1,8 +1,8 @@
 //! Trajectory CSV (docs/physics.md §6): `frame,time,particle,x,y,z,vx,vy,vz`, numbers in
 //! their shortest round-trip form ([`hooke_core::Num`]: scientific far from 1).
 
+use crate::error::{Context, Result};
 use crate::output::OutputFile;
-use anyhow::{Context, Result};
 use hooke_core::{Num, Particles};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -28,8 +28,8 @@ impl TrajectoryWriter {
         })
     }
 
-    /// Appends one frame.
-    pub fn frame(&mut self, frame: u64, time: f64, p: &Particles) -> Result<()> {
+    /// Appends one frame of particles at `time` seconds.
+    pub fn append(&mut self, frame: u64, time: f64, p: &Particles) -> Result<()> {
         let w = self.file.writer();
         for (i, (x, v)) in p.x.iter().zip(&p.v).enumerate() {
             writeln!(
@@ -47,10 +47,19 @@ impl TrajectoryWriter {
         }
         Ok(())
     }
+}
+
+impl crate::Sink for TrajectoryWriter {
+    fn frame(&mut self, frame: u64, scene: &hooke_scene::Scene) -> Result<()> {
+        // docs/physics.md §6: the time of frame f is (f K) dt computed as one product.
+        let time = (frame * scene.every) as f64 * scene.simulation.dt();
+        self.append(frame, time, scene.simulation.particles())
+    }
 
     /// Puts the file in place. Called after the last frame, and after a divergence too: the
     /// frames written before it are complete and stay.
-    pub fn finish(self) -> Result<()> {
-        self.file.commit()
+    fn finish(self: Box<Self>) -> Result<String> {
+        self.file.commit()?;
+        Ok(format!("trajectory: {}", self.path.display()))
     }
 }

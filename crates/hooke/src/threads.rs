@@ -2,7 +2,7 @@
 //! same bits on any count, so more threads than cores only cost; a count in the thousands
 //! (a typo, an extra zero) would start that many OS threads and stall the machine.
 
-use anyhow::{Context, Result, bail};
+use crate::error::{Context, Result, bail_input};
 
 /// The most threads any machine is given.
 pub const MAX_THREADS: usize = 256;
@@ -17,7 +17,7 @@ pub fn max_threads() -> usize {
 /// [`max_threads`].
 ///
 /// ```
-/// use hooke_cli::threads::{checked, max_threads};
+/// use hooke::threads::{checked, max_threads};
 /// assert_eq!(checked(1, "--threads").unwrap(), 1);
 /// assert!(checked(0, "--threads").is_err());
 /// assert!(checked(max_threads() + 1, "--threads").is_err());
@@ -26,10 +26,10 @@ pub fn checked(requested: usize, name: &str) -> Result<usize> {
     let max = max_threads();
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     if requested == 0 {
-        bail!("{name}: expected at least 1 thread");
+        bail_input!("{name}: expected at least 1 thread");
     }
     if requested > max {
-        bail!(
+        bail_input!(
             "{name} {requested}: expected at most {max} threads on this machine ({cores} \
              core{}; four per core, {MAX_THREADS} at most): results are the same on any count, \
              and more threads than cores only slow the run down",
@@ -49,7 +49,7 @@ pub fn from_environment() -> Result<Option<usize>> {
         Ok(0) => Ok(None),
         Ok(n) => checked(n, "RAYON_NUM_THREADS").map(Some),
         Err(_) if text.trim().is_empty() => Ok(None),
-        Err(_) => bail!("RAYON_NUM_THREADS={text}: expected a whole number of threads"),
+        Err(_) => bail_input!("RAYON_NUM_THREADS={text}: expected a whole number of threads"),
     }
 }
 

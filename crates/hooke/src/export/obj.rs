@@ -8,8 +8,8 @@
 //! [`super::collider_triangles`]). Numbers are Rust's shortest round-trip numbers
 //! ([`hooke_core::Num`]); every file is written whole or not at all.
 
+use crate::error::{Context, Result};
 use crate::output::OutputFile;
-use anyhow::{Context, Result};
 use hooke_core::{Num, Spring, Vec3};
 use hooke_scene::{Body, Scene};
 use std::io::Write;
@@ -44,30 +44,9 @@ impl ObjExport {
         })
     }
 
-    /// What was written, for the run's report.
-    pub fn summary(&self) -> String {
-        format!(
-            "{} OBJ frame{} in {}",
-            self.frames,
-            if self.frames == 1 { "" } else { "s" },
-            self.dir.display()
-        )
-    }
-
     /// The file of frame `frame`.
     pub fn path(&self, frame: u64) -> PathBuf {
         self.dir.join(crate::output::frame_name(frame, "obj"))
-    }
-
-    /// Writes frame `frame` of `scene` at its current state.
-    pub fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
-        let path = self.path(frame);
-        let mut file = OutputFile::create(&path)?;
-        write_frame(file.writer(), frame, scene, &self.colliders)
-            .with_context(|| format!("cannot write {}", path.display()))?;
-        file.commit()?;
-        self.frames += 1;
-        Ok(())
     }
 }
 
@@ -138,4 +117,27 @@ fn write_frame(
         base += 3 * tris.len();
     }
     Ok(())
+}
+
+impl crate::Sink for ObjExport {
+    /// Writes frame `frame` of `scene` at its current state.
+    fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
+        let path = self.path(frame);
+        let mut file = OutputFile::create(&path)?;
+        write_frame(file.writer(), frame, scene, &self.colliders)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        file.commit()?;
+        self.frames += 1;
+        Ok(())
+    }
+
+    /// What was written, for the run's report.
+    fn finish(self: Box<Self>) -> Result<String> {
+        Ok(format!(
+            "{} OBJ frame{} in {}",
+            self.frames,
+            if self.frames == 1 { "" } else { "s" },
+            self.dir.display()
+        ))
+    }
 }

@@ -22,8 +22,8 @@
 //! block, when it ends. Memory stays flat however long the run.
 
 use super::{Shape, shape};
+use crate::error::{Context, Result};
 use crate::output::OutputFile;
-use anyhow::{Context, Result};
 use hooke_core::{Num, Vec3};
 use hooke_scene::Scene;
 use std::fmt::Write as _;
@@ -130,63 +130,6 @@ impl UsdExport {
             frames: 0,
             frame_time: scene.every as f64 * scene.simulation.dt(),
         })
-    }
-
-    /// Appends frame `frame` of `scene` to every body's samples.
-    pub fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
-        let p = scene.simulation.particles();
-        for (body, stream) in scene.bodies.iter().zip(&mut self.bodies) {
-            let r = body.range.clone();
-            let write = |file: &mut OutputFile, values: &mut dyn Iterator<Item = [f32; 3]>| {
-                let w = file.writer();
-                write!(w, "            {frame}: [")?;
-                for (k, v) in values.enumerate() {
-                    if k > 0 {
-                        w.write_all(b", ")?;
-                    }
-                    write!(w, "({}, {}, {})", F(v[0]), F(v[1]), F(v[2]))?;
-                }
-                w.write_all(b"],\n")
-            };
-            let (lo, hi) = p.x[r.clone()].iter().fold(
-                (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
-                |(lo, hi), x| (lo.inf(x), hi.sup(x)),
-            );
-            (|| -> std::io::Result<()> {
-                write(
-                    &mut stream.points,
-                    &mut p.x[r.clone()].iter().map(super::f32s),
-                )?;
-                write(
-                    &mut stream.velocities,
-                    &mut p.v[r.clone()].iter().map(super::f32s),
-                )?;
-                // The extent holds every point: rounded outwards to f32.
-                let (lo, hi) = (lo.map(|c| outward(c, false)), hi.map(|c| outward(c, true)));
-                write(
-                    &mut stream.extent,
-                    &mut [[lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z]].into_iter(),
-                )
-            })()
-            .with_context(|| format!("cannot write the samples of {}", self.path.display()))?;
-        }
-        self.frames += 1;
-        Ok(())
-    }
-
-    /// Assembles the stage from the samples written so far and puts it in place.
-    pub fn finish(mut self) -> Result<String> {
-        let mut file = OutputFile::create(&self.path)?;
-        self.assemble(&mut file)
-            .with_context(|| format!("cannot write {}", self.path.display()))?;
-        file.commit()?;
-        Ok(format!(
-            "{} ({} frame{} at {} frames/s)",
-            self.path.display(),
-            self.frames,
-            if self.frames == 1 { "" } else { "s" },
-            Num(1.0 / self.frame_time)
-        ))
     }
 
     fn assemble(&mut self, file: &mut OutputFile) -> Result<()> {
@@ -308,4 +251,63 @@ fn colliders(scene: &Scene) -> Result<String> {
     }
     writeln!(s, "    }}")?;
     Ok(s)
+}
+
+impl crate::Sink for UsdExport {
+    /// Appends frame `frame` of `scene` to every body's samples.
+    fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
+        let p = scene.simulation.particles();
+        for (body, stream) in scene.bodies.iter().zip(&mut self.bodies) {
+            let r = body.range.clone();
+            let write = |file: &mut OutputFile, values: &mut dyn Iterator<Item = [f32; 3]>| {
+                let w = file.writer();
+                write!(w, "            {frame}: [")?;
+                for (k, v) in values.enumerate() {
+                    if k > 0 {
+                        w.write_all(b", ")?;
+                    }
+                    write!(w, "({}, {}, {})", F(v[0]), F(v[1]), F(v[2]))?;
+                }
+                w.write_all(b"],\n")
+            };
+            let (lo, hi) = p.x[r.clone()].iter().fold(
+                (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
+                |(lo, hi), x| (lo.inf(x), hi.sup(x)),
+            );
+            (|| -> std::io::Result<()> {
+                write(
+                    &mut stream.points,
+                    &mut p.x[r.clone()].iter().map(super::f32s),
+                )?;
+                write(
+                    &mut stream.velocities,
+                    &mut p.v[r.clone()].iter().map(super::f32s),
+                )?;
+                // The extent holds every point: rounded outwards to f32.
+                let (lo, hi) = (lo.map(|c| outward(c, false)), hi.map(|c| outward(c, true)));
+                write(
+                    &mut stream.extent,
+                    &mut [[lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z]].into_iter(),
+                )
+            })()
+            .with_context(|| format!("cannot write the samples of {}", self.path.display()))?;
+        }
+        self.frames += 1;
+        Ok(())
+    }
+
+    /// Assembles the stage from the samples written so far and puts it in place.
+    fn finish(mut self: Box<Self>) -> Result<String> {
+        let mut file = OutputFile::create(&self.path)?;
+        self.assemble(&mut file)
+            .with_context(|| format!("cannot write {}", self.path.display()))?;
+        file.commit()?;
+        Ok(format!(
+            "{} ({} frame{} at {} frames/s)",
+            self.path.display(),
+            self.frames,
+            if self.frames == 1 { "" } else { "s" },
+            Num(1.0 / self.frame_time)
+        ))
+    }
 }

@@ -4,7 +4,7 @@
 //! with a `K`, `M` or `G` suffix). Scenes whose estimated footprint exceeds it are refused
 //! before they are built.
 
-use anyhow::{Result, bail};
+use crate::error::{Result, bail_input};
 use hooke_scene::footprint::Footprint;
 
 /// The environment variable that sets the budget.
@@ -13,7 +13,7 @@ pub const BUDGET_VAR: &str = "HOOKE_MAX_MEMORY";
 /// Parses `123`, `512K`, `300M`, `2.5G` (binary multiples) into bytes.
 ///
 /// ```
-/// use hooke_cli::memory::parse_bytes;
+/// use hooke::memory::parse_bytes;
 /// assert_eq!(parse_bytes("2G"), Some(2 << 30));
 /// assert_eq!(parse_bytes("1.5k"), Some(1536));
 /// assert_eq!(parse_bytes("-1"), None);
@@ -84,7 +84,7 @@ pub fn budget() -> Result<Option<(u64, &'static str)>> {
     match std::env::var(BUDGET_VAR) {
         Ok(text) => match parse_bytes(&text) {
             Some(b) => Ok(Some((b, BUDGET_VAR))),
-            None => bail!(
+            None => bail_input!(
                 "{BUDGET_VAR}={text}: expected a number of bytes, optionally with K, M or G \
                  (such as 4G)"
             ),
@@ -111,7 +111,7 @@ pub fn check_reading(path: &std::path::Path, need: u64) -> Result<()> {
     };
     if need > budget {
         let len = std::fs::metadata(path).map_or(0, |m| m.len());
-        bail!(
+        bail_input!(
             "{}: reading this {} file would need about {}, more than the {} of {source}",
             path.display(),
             human(len),
@@ -144,7 +144,7 @@ pub fn check(name: &str, footprint: &Footprint) -> Result<()> {
             format!("; most of it is {k} ({}): {advice}", human(*b))
         })
         .unwrap_or_default();
-    bail!(
+    bail_input!(
         "scene '{name}' would need about {} ({} particles, {} springs), more than the {} of \
          {source}{key}",
         human(need),

@@ -1,9 +1,9 @@
 //! The demo's still of each built-in scene: when it is taken and from where. `hooke demo`
 //! writes them; the validation suite compares them with the golden images.
 
+use crate::error::Result;
 use crate::image_out::View;
 use crate::source;
-use anyhow::Result;
 use hooke_scene::{Overrides, Scene};
 
 /// Scenes whose still is taken before the end of the run, and when (seconds): the jelly is
@@ -34,19 +34,5 @@ pub fn still_view(name: &str, view: &View) -> View {
     View {
         yaw: view.yaw + turn,
         ..view.clone()
-    }
-}
-
-impl Default for View {
-    /// The command line's defaults: 800×600, solid, yaw 30°, pitch 22°, 4× anti-aliasing.
-    fn default() -> Self {
-        Self {
-            size: (800, 600),
-            style: crate::draw::Style::Solid,
-            yaw: crate::draw::DEFAULT_YAW_PITCH.0,
-            pitch: crate::draw::DEFAULT_YAW_PITCH.1,
-            zoom: 1.0,
-            supersample: 2,
-        }
     }
 }

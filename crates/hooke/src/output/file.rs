@@ -8,7 +8,7 @@
 //! writes into the same folder.
 
 use super::destination::{Destination, destination, folder};
-use anyhow::{Context, Result};
+use crate::error::{Context, Result};
 use std::collections::HashSet;
 use std::fs::File;
 use std::io::{BufWriter, Seek, SeekFrom, Write};
@@ -207,7 +207,7 @@ impl OutputFile {
             Some((temp, _)) => {
                 File::open(temp).with_context(|| format!("cannot read back {}", temp.display()))
             }
-            None => anyhow::bail!("{shown} is a stream: it cannot be read back"),
+            None => crate::error::bail_output!("{shown} is a stream: it cannot be read back"),
         }
     }
 

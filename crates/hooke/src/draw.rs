@@ -5,7 +5,8 @@ use hooke_render::{Camera, DrawList, Line, Mesh, Point, Rgb};
 use hooke_scene::{ColliderGeometry, Scene, Topology, collider_mesh};
 
 /// What to draw of the bodies.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Style {
     /// Shaded surfaces (cloth, jelly); chains as beads on a string.
     Solid,
@@ -13,6 +14,18 @@ pub enum Style {
     Springs,
     /// Surfaces and springs together.
     Both,
+}
+
+impl Style {
+    /// The style named `solid`, `springs` or `both` (any case).
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name.to_ascii_lowercase().as_str() {
+            "solid" => Some(Self::Solid),
+            "springs" => Some(Self::Springs),
+            "both" => Some(Self::Both),
+            _ => None,
+        }
+    }
 }
 
 const CLOTH: Rgb = [0.22, 0.42, 0.78];

@@ -15,8 +15,8 @@
 //! Samples are appended as the run goes; the count in the header is written when the run
 //! ends, at the last complete frame.
 
+use crate::error::{Context, Result, bail_output};
 use crate::output::OutputFile;
-use anyhow::{Context, Result, bail};
 use hooke_scene::{Body, Scene};
 use std::io::{Seek, SeekFrom, Write};
 use std::ops::Range;
@@ -43,13 +43,13 @@ fn pick<'a>(scene: &'a Scene, name: Option<&str>) -> Result<&'a Body> {
     match name {
         None => match scene.bodies.first() {
             Some(b) => Ok(b),
-            None => bail!("--export: scene {} has no body to cache", scene.spec.name),
+            None => bail_output!("--export: scene {} has no body to cache", scene.spec.name),
         },
         Some(name) => match scene.bodies.iter().find(|b| b.name == name) {
             Some(b) => Ok(b),
             None => {
                 let names: Vec<&str> = scene.bodies.iter().map(|b| b.name.as_str()).collect();
-                bail!(
+                bail_output!(
                     "--body {name}: scene {} has no such body; it has {}",
                     scene.spec.name,
                     names.join(", ")
@@ -67,7 +67,12 @@ impl Pc2Export {
         let points = u32::try_from(body.range.len())
             .ok()
             .filter(|&n| n <= i32::MAX as u32)
-            .with_context(|| format!("--export: body {} is too large for a PC2", body.name))?;
+            .ok_or_else(|| {
+                crate::Error::output(format!(
+                    "--export: body {} is too large for a PC2",
+                    body.name
+                ))
+            })?;
         let mesh = path.with_extension("obj");
         let mut obj = OutputFile::create(&mesh)?;
         let sim = &scene.simulation;
@@ -105,9 +110,11 @@ impl Pc2Export {
             samples: 0,
         })
     }
+}
 
+impl crate::Sink for Pc2Export {
     /// Appends frame `frame` of `scene` as the next sample.
-    pub fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
+    fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
         debug_assert_eq!(frame, u64::from(self.samples));
         let x = &scene.simulation.particles().x[self.range.clone()];
         let w = self.file.writer();
@@ -124,7 +131,7 @@ impl Pc2Export {
     }
 
     /// Writes the sample count and puts the cache in place.
-    pub fn finish(mut self) -> Result<String> {
+    fn finish(mut self: Box<Self>) -> Result<String> {
         let samples = self.samples as i32;
         let w = self.file.writer();
         (|| -> std::io::Result<()> {

@@ -65,7 +65,7 @@ pub fn check(simulation: &hooke_core::Simulation) -> Result<(), Interrupted> {
     }
 }
 
-/// Whether `e` (or its cause) is an interrupt.
-pub fn is_interrupt(e: &anyhow::Error) -> bool {
-    e.chain().any(|c| c.downcast_ref::<Interrupted>().is_some())
+/// Whether `e` is an interrupt.
+pub fn is_interrupt(e: &crate::Error) -> bool {
+    matches!(e, crate::Error::Interrupted { .. })
 }

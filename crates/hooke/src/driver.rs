@@ -1,33 +1,23 @@
 //! The run loop: stepping a scene frame by frame, answering Ctrl-C within a step and
 //! showing progress on long runs.
 
+use crate::error::{Result, bail_input};
 use crate::interrupt;
-use anyhow::{Result, bail};
+use crate::progress::{Hidden, Progress, reporter};
 use hooke_core::Num;
 use hooke_scene::Scene;
-use indicatif::{ProgressBar, ProgressStyle};
-use std::io::IsTerminal;
 use std::time::{Duration, Instant};
 
 /// Runs shorter than this many steps show no progress bar.
 const PROGRESS_FROM: u64 = 10_000;
 
-/// A progress bar on stderr for `steps` steps of the scene, hidden when stderr is not a
-/// terminal or the run is short.
-fn progress(scene: &Scene, steps: u64) -> ProgressBar {
-    if !std::io::stderr().is_terminal() || steps < PROGRESS_FROM {
-        return ProgressBar::hidden();
+/// The progress of `steps` steps of the scene, shown by the installed reporter when the
+/// run is long.
+fn progress(scene: &Scene, steps: u64) -> Box<dyn Progress> {
+    if steps < PROGRESS_FROM {
+        return Box::new(Hidden);
     }
-    let bar = ProgressBar::new(steps);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{prefix} [{bar:40}] {pos}/{len} steps, {elapsed} elapsed, eta {eta}",
-        )
-        .expect("valid template")
-        .progress_chars("=> "),
-    );
-    bar.set_prefix(scene.spec.name.clone());
-    bar
+    reporter().run(&scene.spec.name, steps)
 }
 
 /// The whole number of the scene's steps nearest to `seconds` of simulated time (what
@@ -35,10 +25,10 @@ fn progress(scene: &Scene, steps: u64) -> ProgressBar {
 /// for times no run reaches.
 ///
 /// ```
-/// let scene = hooke_cli::source::build("chain", &Default::default()).unwrap();
+/// let scene = hooke::source::build("chain", &Default::default()).unwrap();
 /// let dt = scene.simulation.dt();
-/// assert_eq!(hooke_cli::driver::steps_for(&scene, 10.4 * dt), 10);
-/// assert_eq!(hooke_cli::driver::steps_for(&scene, 1e300), u64::MAX);
+/// assert_eq!(hooke::driver::steps_for(&scene, 10.4 * dt), 10);
+/// assert_eq!(hooke::driver::steps_for(&scene, 1e300), u64::MAX);
 /// ```
 pub fn steps_for(scene: &Scene, seconds: f64) -> u64 {
     // `as` saturates: negative and NaN give 0, beyond range u64::MAX.
@@ -54,22 +44,22 @@ pub const MAX_STILL_STEPS: f64 = 1e12;
 /// [`MAX_STILL_STEPS`] steps away.
 ///
 /// ```
-/// let scene = hooke_cli::source::build("chain", &Default::default()).unwrap();
-/// assert_eq!(hooke_cli::driver::steps_to(&scene, None).unwrap(), scene.steps);
-/// assert!(hooke_cli::driver::steps_to(&scene, Some(1e300)).is_err());
-/// assert!(hooke_cli::driver::steps_to(&scene, Some(-1.0)).is_err());
+/// let scene = hooke::source::build("chain", &Default::default()).unwrap();
+/// assert_eq!(hooke::driver::steps_to(&scene, None).unwrap(), scene.steps);
+/// assert!(hooke::driver::steps_to(&scene, Some(1e300)).is_err());
+/// assert!(hooke::driver::steps_to(&scene, Some(-1.0)).is_err());
 /// ```
 pub fn steps_to(scene: &Scene, at: Option<f64>) -> Result<u64> {
     let Some(t) = at else {
         return Ok(scene.steps);
     };
     if !(t.is_finite() && t >= 0.0) {
-        bail!("--at: expected a time in seconds >= 0, found {}", Num(t));
+        bail_input!("--at: expected a time in seconds >= 0, found {}", Num(t));
     }
     let dt = scene.simulation.dt();
     let steps = (t / dt).round();
     if steps > MAX_STILL_STEPS {
-        bail!(
+        bail_input!(
             "--at {} s is {steps:.1e} steps of dt = {} s, more than the {MAX_STILL_STEPS:.0e} a \
              still may take; choose an earlier time or a larger --dt",
             Num(t),
@@ -80,12 +70,12 @@ pub fn steps_to(scene: &Scene, at: Option<f64>) -> Result<u64> {
 }
 
 /// Steps `n` times, one at a time so that an interrupt is answered within a step.
-fn steps(scene: &mut Scene, n: u64, bar: &ProgressBar) -> Result<()> {
+fn steps(scene: &mut Scene, n: u64, bar: &dyn Progress) -> Result<()> {
     for k in 0..n {
         interrupt::check(&scene.simulation)?;
         scene.simulation.step()?;
         if k % 1024 == 1023 {
-            bar.set_position(scene.simulation.steps());
+            bar.set(scene.simulation.steps());
         }
     }
     Ok(())
@@ -99,20 +89,20 @@ pub fn drive(scene: &mut Scene, mut on_frame: impl FnMut(u64, &Scene) -> Result<
     let bar = progress(scene, total);
     on_frame(0, scene)?;
     for frame in 1..=total / every {
-        steps(scene, every, &bar)?;
+        steps(scene, every, bar.as_ref())?;
         on_frame(frame, scene)?;
     }
     // Steps past the last full frame are still run: the run's length is what was asked for.
-    steps(scene, total % every, &bar)?;
-    bar.finish_and_clear();
+    steps(scene, total % every, bar.as_ref())?;
+    bar.finish();
     Ok(())
 }
 
 /// Steps `scene` `n` times without frames, interruptible, with progress on long runs.
 pub fn advance(scene: &mut Scene, n: u64) -> Result<()> {
     let bar = progress(scene, n);
-    steps(scene, n, &bar)?;
-    bar.finish_and_clear();
+    steps(scene, n, bar.as_ref())?;
+    bar.finish();
     Ok(())
 }
 
@@ -124,9 +114,9 @@ pub fn advance(scene: &mut Scene, n: u64) -> Result<()> {
 ///
 /// ```
 /// use std::time::Duration;
-/// let mut scene = hooke_cli::source::build("chain", &Default::default()).unwrap();
+/// let mut scene = hooke::source::build("chain", &Default::default()).unwrap();
 /// let dt = scene.simulation.dt();
-/// let left = hooke_cli::driver::catch_up(&mut scene, 10.5 * dt, Duration::from_secs(60)).unwrap();
+/// let left = hooke::driver::catch_up(&mut scene, 10.5 * dt, Duration::from_secs(60)).unwrap();
 /// assert_eq!(scene.simulation.steps(), 10);
 /// assert!((left - 0.5 * dt).abs() < 1e-12);
 /// ```

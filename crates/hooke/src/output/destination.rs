@@ -2,7 +2,7 @@
 //! place), or a stream — standard output (`-`), a character device such as `/dev/null`, a
 //! FIFO — which is written straight through and never replaced.
 
-use anyhow::{Result, bail};
+use crate::error::{Result, bail_output};
 use std::path::{Path, PathBuf};
 
 /// What an output path names.
@@ -37,7 +37,7 @@ const SYSTEM_FOLDERS: [&str; 2] = ["/dev/", "/proc/"];
 /// folder, a block device, a socket, a link to nowhere, a missing folder.
 ///
 /// ```
-/// use hooke_cli::output::destination::{Destination, destination};
+/// use hooke::output::destination::{Destination, destination};
 /// use std::path::Path;
 /// assert_eq!(destination(Path::new("-"), "--trajectory").unwrap(), Destination::Stdout);
 /// assert!(destination(Path::new("/dev/null"), "--trajectory").unwrap().is_stream());
@@ -51,7 +51,7 @@ pub fn destination(path: &Path, flag: &str) -> Result<Destination> {
     }
     let text = path.to_string_lossy();
     if text.ends_with('/') {
-        bail!("{flag} {shown}: is a folder, expected a file name");
+        bail_output!("{flag} {shown}: is a folder, expected a file name");
     }
     let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
     let system = SYSTEM_FOLDERS
@@ -61,16 +61,16 @@ pub fn destination(path: &Path, flag: &str) -> Result<Destination> {
         Ok(meta) => {
             let kind = meta.file_type();
             if kind.is_dir() {
-                bail!("{flag} {shown}: is a folder, expected a file name");
+                bail_output!("{flag} {shown}: is a folder, expected a file name");
             }
             if kind.is_block_device() {
-                bail!(
+                bail_output!(
                     "{flag} {shown}: is a block device; outputs go to files, character devices, \
                      FIFOs or - (standard output)"
                 );
             }
             if kind.is_socket() {
-                bail!("{flag} {shown}: is a socket, which cannot be opened for writing");
+                bail_output!("{flag} {shown}: is a socket, which cannot be opened for writing");
             }
             if kind.is_char_device() || kind.is_fifo() || system {
                 return Ok(Destination::Stream(path.to_path_buf()));
@@ -79,25 +79,29 @@ pub fn destination(path: &Path, flag: &str) -> Result<Destination> {
             Ok(Destination::File { target })
         }
         Err(_) if system => {
-            bail!("{flag} {shown}: no such device; hooke creates no files under /dev or /proc")
+            bail_output!(
+                "{flag} {shown}: no such device; hooke creates no files under /dev or /proc"
+            )
         }
         Err(_) => {
             if std::fs::symlink_metadata(path).is_ok() {
-                bail!("{flag} {shown}: is a symbolic link to nothing");
+                bail_output!("{flag} {shown}: is a symbolic link to nothing");
             }
             let name = path
                 .file_name()
                 .filter(|n| *n != "." && *n != "..")
-                .ok_or_else(|| anyhow::anyhow!("{flag} {shown}: expected a file name"))?;
+                .ok_or_else(|| {
+                    crate::Error::output(format!("{flag} {shown}: expected a file name"))
+                })?;
             let parent = folder(path);
             let Ok(parent) = parent.canonicalize() else {
-                bail!(
+                bail_output!(
                     "{flag} {shown}: the folder {} does not exist",
                     parent.display()
                 );
             };
             if !parent.is_dir() {
-                bail!("{flag} {shown}: {} is not a folder", folder(path).display());
+                bail_output!("{flag} {shown}: {} is not a folder", folder(path).display());
             }
             Ok(Destination::File {
                 target: parent.join(name),

@@ -7,8 +7,8 @@
 //! triangles as `vertex_indices`. Colliders do not move and are left out (`--format obj`
 //! has them). Values are `float`, as renderers read them.
 
+use crate::error::{Context, Result};
 use crate::output::OutputFile;
-use anyhow::{Context, Result};
 use hooke_core::{Num, Vec3};
 use hooke_scene::Scene;
 use ply_rs_bw::ply::{
@@ -127,25 +127,6 @@ impl PlyExport {
         self.dir.join(crate::output::frame_name(frame, "ply"))
     }
 
-    /// Writes frame `frame` of `scene` at its current state.
-    pub fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
-        let x = &scene.simulation.particles().x;
-        super::vertex_normals(x, &self.triangles, &mut self.normals);
-        self.vertices.clear();
-        self.vertices
-            .extend(x.iter().zip(&self.normals).map(|(p, n)| PlyVertex {
-                x: super::f32s(p),
-                n: super::f32s(n),
-            }));
-        let path = self.path(frame);
-        let mut file = OutputFile::create(&path)?;
-        self.write(file.writer(), frame, scene)
-            .with_context(|| format!("cannot write {}", path.display()))?;
-        file.commit()?;
-        self.frames += 1;
-        Ok(())
-    }
-
     fn write(
         &self,
         out: &mut impl std::io::Write,
@@ -184,14 +165,35 @@ impl PlyExport {
         Writer::<PlyFace>::new().write_payload_of_element(out, &self.faces, &face, &header)?;
         Ok(())
     }
+}
+
+impl crate::Sink for PlyExport {
+    /// Writes frame `frame` of `scene` at its current state.
+    fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
+        let x = &scene.simulation.particles().x;
+        super::vertex_normals(x, &self.triangles, &mut self.normals);
+        self.vertices.clear();
+        self.vertices
+            .extend(x.iter().zip(&self.normals).map(|(p, n)| PlyVertex {
+                x: super::f32s(p),
+                n: super::f32s(n),
+            }));
+        let path = self.path(frame);
+        let mut file = OutputFile::create(&path)?;
+        self.write(file.writer(), frame, scene)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        file.commit()?;
+        self.frames += 1;
+        Ok(())
+    }
 
     /// What was written, for the run's report.
-    pub fn summary(&self) -> String {
-        format!(
+    fn finish(self: Box<Self>) -> Result<String> {
+        Ok(format!(
             "{} PLY frame{} in {}",
             self.frames,
             if self.frames == 1 { "" } else { "s" },
             self.dir.display()
-        )
+        ))
     }
 }

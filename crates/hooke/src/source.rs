@@ -1,10 +1,8 @@
 //! Turning a SCENE argument (built-in name, `.toml` scene or `.w` world) into a scene.
 
-use anyhow::{Context, Result, bail};
+use crate::error::{Context, Result, bail_input};
 use hooke_scene::builtin::BUILTINS;
 use hooke_scene::{BuildError, Overrides, Scene, SceneSpec, TableOverride};
-use indicatif::ProgressBar;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 /// Where a scene came from.
@@ -41,7 +39,9 @@ pub fn read(arg: &str) -> Result<Source> {
     let path = Path::new(arg);
     // A folder named like a built-in (`mkdir chain`) does not hide the built-in.
     if path.is_dir() && hooke_scene::builtin::builtin(arg).is_none() {
-        bail!("{arg} is a folder; expected a built-in scene name, a .toml scene or a .w world");
+        bail_input!(
+            "{arg} is a folder; expected a built-in scene name, a .toml scene or a .w world"
+        );
     }
     let is_file = path.extension().is_some_and(|e| e == "toml" || e == "w") || path.is_file();
     if !is_file {
@@ -69,7 +69,7 @@ pub fn read(arg: &str) -> Result<Source> {
             .to_scene(&stem(path))
             .with_context(|| format!("{}", path.display()))?,
         Some("toml") => hooke_scene::load_scene(path)?,
-        _ => bail!(
+        _ => bail_input!(
             "{}: expected a scene file ending in .toml or a jello world ending in .w",
             path.display()
         ),
@@ -98,12 +98,14 @@ pub fn table(value: &str) -> Result<TableOverride> {
     }
     let path = Path::new(value);
     if path.is_dir() {
-        bail!(
+        bail_input!(
             "--table {value}: is a folder; expected an OBJ mesh file, builtin:NAME or `cylinder`"
         );
     }
     if !path.is_file() {
-        bail!("--table {value}: no such file (expected an OBJ mesh, builtin:NAME or `cylinder`)");
+        bail_input!(
+            "--table {value}: no such file (expected an OBJ mesh, builtin:NAME or `cylinder`)"
+        );
     }
     let full = std::env::current_dir()?.join(path);
     Ok(TableOverride::Mesh(full.to_string_lossy().into_owned()))
@@ -140,7 +142,7 @@ pub fn prepare(mut source: Source, arg: &str, overrides: &Overrides) -> Result<S
             },
             other => other,
         };
-        anyhow::Error::new(e).context(format!("scene '{arg}'"))
+        crate::Error::from(e).context(format!("scene '{arg}'"))
     })?;
     Ok(source)
 }
@@ -151,32 +153,21 @@ pub fn build_prepared(source: Source, arg: &str) -> Result<Scene> {
     let footprint = source.spec.footprint(&source.base);
     crate::memory::check(arg, &footprint)?;
     let large = footprint.bytes() >= ANNOUNCE_BYTES;
-    let spinner = if large && std::io::stderr().is_terminal() {
-        let bar = ProgressBar::new_spinner();
-        bar.set_message(format!(
+    let spinner = if large {
+        crate::progress::reporter().build(&format!(
             "building scene '{arg}': {} particles, {} springs, about {}",
             footprint.particles,
             footprint.springs,
             crate::memory::human(footprint.bytes())
-        ));
-        bar.enable_steady_tick(std::time::Duration::from_millis(120));
-        bar
+        ))
     } else {
-        if large {
-            eprintln!(
-                "building scene '{arg}': {} particles, {} springs, about {}; this takes a while",
-                footprint.particles,
-                footprint.springs,
-                crate::memory::human(footprint.bytes())
-            );
-        }
-        ProgressBar::hidden()
+        Box::new(crate::progress::Hidden)
     };
     let scene = source
         .spec
         .build(&source.base)
         .with_context(|| format!("scene '{arg}'"));
-    spinner.finish_and_clear();
+    spinner.finish();
     if let Ok(scene) = &scene {
         for warning in scene.warnings() {
             eprintln!("warning: scene '{arg}': {warning}");

@@ -1,74 +1,59 @@
 //! Rendering scenes to PNG stills and GIF animations, written atomically; a GIF is encoded
 //! frame by frame as a run produces them, so its memory does not grow with its length.
 
-use crate::draw::{DEFAULT_YAW_PITCH, Style, draw, frame_camera};
+use crate::draw::{Style, draw, frame_camera};
+use crate::error::{Context, Result};
 use crate::output::{OutputFile, write_atomic};
-use anyhow::{Context, Result};
 use hooke_render::{Camera, RenderOptions, render};
 use hooke_scene::Scene;
 use image::{ImageFormat, RgbaImage};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
-/// Camera placement options shared by the commands that draw.
-#[derive(clap::Args, Clone, Debug)]
+/// Where the camera looks from and what it draws: what a still needs besides the scene.
+#[derive(Clone, Debug, PartialEq)]
 pub struct View {
-    /// Image size as WIDTHxHEIGHT.
-    #[arg(long, default_value = "800x600", value_parser = parse_size)]
+    /// Image size in pixels, width and height, each from 8 to 8192.
     pub size: (u32, u32),
     /// What to draw.
-    #[arg(long, value_enum, default_value_t = Style::Solid)]
     pub style: Style,
     /// Camera rotation about the vertical, degrees.
-    #[arg(long, default_value_t = DEFAULT_YAW_PITCH.0, allow_negative_numbers = true, value_parser = parse_angle)]
     pub yaw: f64,
     /// Camera elevation, degrees, from -89 to 89.
-    #[arg(long, default_value_t = DEFAULT_YAW_PITCH.1, allow_negative_numbers = true, value_parser = parse_pitch)]
     pub pitch: f64,
-    /// Multiply the framing distance, from 0.001 to 1000 (less than 1 zooms in).
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = parse_zoom)]
+    /// Factor on the framing distance, from 0.001 to 1000 (less than 1 zooms in).
     pub zoom: f64,
     /// Samples per pixel along each axis, 1 to 4 (2 = 4× anti-aliasing, 1 = off).
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=4))]
     pub supersample: u32,
 }
 
-/// Image sides in pixels.
-const SIDE: std::ops::RangeInclusive<u32> = 8..=8192;
-/// Camera rotation about the vertical, degrees.
-const YAW: (f64, f64) = (-3600.0, 3600.0);
-/// Camera elevation, degrees: at ±90° the view direction is the up vector and the camera
-/// has no orientation.
-const PITCH: (f64, f64) = (-89.0, 89.0);
-/// Factor on the framing distance.
-const ZOOM: (f64, f64) = (1e-3, 1e3);
-
-/// Parses `WIDTHxHEIGHT`, each from 8 to 8192 pixels.
-pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once('x')
-        .ok_or_else(|| format!("expected WIDTHxHEIGHT such as 800x600, found '{s}'"))?;
-    let parse = |v: &str| v.parse::<u32>().ok().filter(|n| SIDE.contains(n));
-    match (parse(w), parse(h)) {
-        (Some(w), Some(h)) => Ok((w, h)),
-        _ => Err(format!(
-            "expected WIDTHxHEIGHT with each from 8 to 8192, found '{s}'"
-        )),
+impl Default for View {
+    /// The command line's defaults: 800×600, solid, yaw 30°, pitch 22°, 4× anti-aliasing.
+    fn default() -> Self {
+        Self {
+            size: (800, 600),
+            style: crate::draw::Style::Solid,
+            yaw: crate::draw::DEFAULT_YAW_PITCH.0,
+            pitch: crate::draw::DEFAULT_YAW_PITCH.1,
+            zoom: 1.0,
+            supersample: 2,
+        }
     }
 }
 
-/// Parses a number within `[lo, hi]` for a command-line option.
-pub fn parse_within(s: &str, lo: f64, hi: f64, what: &str) -> Result<f64, String> {
-    let x: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("expected {what}, found '{s}'"))?;
-    in_range(x, (lo, hi), what, s)
-}
+/// Image sides in pixels.
+pub const SIDE: std::ops::RangeInclusive<u32> = 8..=8192;
+/// Camera rotation about the vertical, degrees.
+pub const YAW: (f64, f64) = (-3600.0, 3600.0);
+/// Camera elevation, degrees: at ±90° the view direction is the up vector and the camera
+/// has no orientation.
+pub const PITCH: (f64, f64) = (-89.0, 89.0);
+/// Factor on the framing distance.
+pub const ZOOM: (f64, f64) = (1e-3, 1e3);
 
 /// `x` when it is finite and within `[lo, hi]`; otherwise what `what` expects, with `x`
 /// shown as `shown` (the text given on a command line).
-fn in_range(x: f64, (lo, hi): (f64, f64), what: &str, shown: &str) -> Result<f64, String> {
+pub fn in_range(x: f64, (lo, hi): (f64, f64), what: &str, shown: &str) -> Result<f64, String> {
     if x.is_finite() && (lo..=hi).contains(&x) {
         Ok(x)
     } else {
@@ -80,22 +65,10 @@ fn in_range(x: f64, (lo, hi): (f64, f64), what: &str, shown: &str) -> Result<f64
     }
 }
 
-fn parse_angle(s: &str) -> Result<f64, String> {
-    parse_within(s, YAW.0, YAW.1, "an angle in degrees")
-}
-
-fn parse_pitch(s: &str) -> Result<f64, String> {
-    parse_within(s, PITCH.0, PITCH.1, "an elevation in degrees")
-}
-
-fn parse_zoom(s: &str) -> Result<f64, String> {
-    parse_within(s, ZOOM.0, ZOOM.1, "a zoom factor")
-}
-
 /// [`in_range`] for a value given in code: `option: expected …`.
 fn within(option: &str, x: f64, range: (f64, f64), what: &str) -> Result<f64> {
     in_range(x, range, what, &hooke_core::Num(x).to_string())
-        .map_err(|e| anyhow::anyhow!("{option}: {e}"))
+        .map_err(|e| crate::Error::input(format!("{option}: {e}")))
 }
 
 impl View {
@@ -105,7 +78,7 @@ impl View {
     /// to 4.
     ///
     /// ```
-    /// use hooke_cli::image_out::View;
+    /// use hooke::image_out::View;
     /// assert!(View::checked((320, 240), "solid", (30.0, 22.0), 1.0, 2).is_ok());
     /// assert!(View::checked((320, 240), "solid", (30.0, 95.0), 1.0, 2).is_err());
     /// assert!(View::checked((320, 240), "wire", (30.0, 22.0), 1.0, 2).is_err());
@@ -118,15 +91,17 @@ impl View {
         supersample: u32,
     ) -> Result<Self> {
         if !(SIDE.contains(&width) && SIDE.contains(&height)) {
-            anyhow::bail!(
+            crate::error::bail_input!(
                 "size: expected WIDTHxHEIGHT with each from 8 to 8192, found '{width}x{height}'"
             );
         }
-        let style = <Style as clap::ValueEnum>::from_str(style, true).map_err(|_| {
-            anyhow::anyhow!("style: expected solid, springs or both, found '{style}'")
+        let style = Style::from_name(style).ok_or_else(|| {
+            crate::Error::input(format!(
+                "style: expected solid, springs or both, found '{style}'"
+            ))
         })?;
         if !(1..=4).contains(&supersample) {
-            anyhow::bail!("supersample: expected 1 to 4, found {supersample}");
+            crate::error::bail_input!("supersample: expected 1 to 4, found {supersample}");
         }
         Ok(Self {
             size: (width, height),
@@ -157,36 +132,6 @@ impl View {
         RgbaImage::from_raw(self.size.0, self.size.1, pixels)
             .expect("renderer returns width × height pixels")
     }
-}
-
-/// The options `hooke render` takes that decide the picture, for [`picture_from_args`].
-#[derive(clap::Parser, Debug)]
-#[command(name = "render")]
-struct PictureArgs {
-    /// Built-in scene name.
-    scene: String,
-    /// Simulated time of the picture, seconds.
-    #[arg(long, allow_negative_numbers = true)]
-    at: Option<f64>,
-    #[command(flatten)]
-    view: View,
-}
-
-/// The argument-to-picture path of `hooke render`, in process and without files: `args`
-/// as on the command line after `render` (`chain --at 0.5 --zoom 2 --size 64x48`), the
-/// scene built, run to `--at` as `render` takes it ([`crate::driver::steps_to`]; at most
-/// `max_steps` steps, so that a fuzzer's `--at 1e9` stays quick) and drawn. Any argument
-/// is either refused with an error or gives a picture of the asked size; nothing panics. The fuzz target `args` and a property test drive it.
-pub fn picture_from_args(args: &[String], max_steps: u64) -> Result<RgbaImage> {
-    use clap::Parser;
-    let parsed = PictureArgs::try_parse_from(
-        std::iter::once("render".to_string()).chain(args.iter().cloned()),
-    )?;
-    let mut scene = crate::source::build(&parsed.scene, &hooke_scene::Overrides::default())?;
-    let steps = crate::driver::steps_to(&scene, parsed.at)?.min(max_steps);
-    crate::driver::advance(&mut scene, steps)?;
-    let camera = parsed.view.camera(&scene);
-    Ok(parsed.view.pixels(&scene, &camera))
 }
 
 /// Encodes and writes a PNG atomically.
@@ -233,12 +178,13 @@ impl GifWriter {
 
     /// Quantises and appends one frame of the GIF's size.
     pub fn frame(&mut self, mut image: RgbaImage) -> Result<()> {
-        anyhow::ensure!(
-            image.dimensions() == (self.size.0 as u32, self.size.1 as u32),
-            "GIF frame of {:?} pixels in a GIF of {:?}",
-            image.dimensions(),
-            self.size
-        );
+        if image.dimensions() != (self.size.0 as u32, self.size.1 as u32) {
+            crate::error::bail_output!(
+                "GIF frame of {:?} pixels in a GIF of {:?}",
+                image.dimensions(),
+                self.size
+            );
+        }
         // Speed 10 as image's encoder uses: NeuQuant on a sample of the pixels.
         let mut frame = gif::Frame::from_rgba_speed(self.size.0, self.size.1, &mut image, 10);
         frame.delay = self.delay;
@@ -247,6 +193,11 @@ impl GifWriter {
             .with_context(|| format!("cannot write {}", self.path.display()))?;
         self.frames += 1;
         Ok(())
+    }
+
+    /// Where the GIF goes.
+    pub fn path(&self) -> &Path {
+        &self.path
     }
 
     /// Frames written so far.

@@ -5,7 +5,7 @@
 //! output named like one of its frames would be removed or rewritten by the run.
 
 use super::destination::{Destination, destination};
-use anyhow::{Result, bail};
+use crate::error::{Result, bail_output};
 use std::os::unix::fs::MetadataExt;
 use std::path::{Component, Path, PathBuf};
 
@@ -128,7 +128,7 @@ impl Claims {
     /// file, and a file (read or written) named like a frame in a folder of frames.
     ///
     /// ```
-    /// use hooke_cli::output::claims::Claims;
+    /// use hooke::output::claims::Claims;
     /// let dir = std::env::temp_dir();
     /// let scene = dir.join(format!("claims-doc-{}.toml", std::process::id()));
     /// std::fs::write(&scene, "").unwrap();
@@ -152,7 +152,7 @@ impl Claims {
                     let me = &ids[k];
                     for (what, path, input) in &inputs {
                         if input == me {
-                            bail!(
+                            bail_output!(
                                 "{} {shown}: is {what} {}, which this run reads; refusing to \
                                  overwrite it, choose another name",
                                 out.flag,
@@ -164,14 +164,14 @@ impl Claims {
                         if matches!(other.kind, Kind::File) && other_id == me && !is_null(&out.path)
                         {
                             if *me == Id::Stdout {
-                                bail!(
+                                bail_output!(
                                     "{} and {} both write to standard output: give one of them \
                                      a file",
                                     other.flag,
                                     out.flag
                                 );
                             }
-                            bail!(
+                            bail_output!(
                                 "{} {shown} and {} {} are the same file: each output needs its \
                                  own",
                                 out.flag,
@@ -185,7 +185,7 @@ impl Claims {
                     let dir = &ids[k];
                     for (what, path, _) in &inputs {
                         if in_frames(path, dir, ext) {
-                            bail!(
+                            bail_output!(
                                 "{} {shown}: holds {what} {}, named like the frames this run \
                                  removes and writes; move it or choose another folder",
                                 out.flag,
@@ -200,7 +200,7 @@ impl Claims {
                             Kind::Frames(e) => e == ext && other_id == dir,
                         };
                         if clash {
-                            bail!(
+                            bail_output!(
                                 "{} {}: would be among the frames of {} {shown}, which the run \
                                  removes and writes; choose another name",
                                 other.flag,

@@ -11,7 +11,7 @@ pub mod lock;
 
 pub use file::{OutputFile, remove_pending, write_atomic};
 
-use anyhow::{Context, Result, bail};
+use crate::error::{Context, Result, bail_output};
 use destination::{Destination, destination};
 use lock::FolderLock;
 use std::fs::File;
@@ -25,10 +25,10 @@ use std::path::Path;
 ///
 /// ```
 /// # let dir = std::env::temp_dir();
-/// assert!(hooke_cli::output::check_output_file(&dir, "-o", &["png"]).is_err());
-/// assert!(hooke_cli::output::check_output_file(&dir.join("a.jpg"), "-o", &["png"]).is_err());
-/// assert!(hooke_cli::output::check_output_file(&dir.join("a.png"), "-o", &["png"]).is_ok());
-/// assert!(hooke_cli::output::check_output_file("/dev/null".as_ref(), "-o", &["png"]).is_ok());
+/// assert!(hooke::output::check_output_file(&dir, "-o", &["png"]).is_err());
+/// assert!(hooke::output::check_output_file(&dir.join("a.jpg"), "-o", &["png"]).is_err());
+/// assert!(hooke::output::check_output_file(&dir.join("a.png"), "-o", &["png"]).is_ok());
+/// assert!(hooke::output::check_output_file("/dev/null".as_ref(), "-o", &["png"]).is_ok());
 /// ```
 pub fn check_output_file(path: &Path, flag: &str, extensions: &[&str]) -> Result<Destination> {
     let found = destination(path, flag)?;
@@ -42,7 +42,7 @@ pub fn check_output_file(path: &Path, flag: &str, extensions: &[&str]) -> Result
             .unwrap_or_default();
         if !extensions.contains(&ext.as_str()) {
             let list: Vec<String> = extensions.iter().map(|e| format!(".{e}")).collect();
-            bail!(
+            bail_output!(
                 "{flag} {}: expected a file name ending in {} (the format written), found {}",
                 path.display(),
                 list.join(" or "),
@@ -72,13 +72,15 @@ pub fn check_output_file(path: &Path, flag: &str, extensions: &[&str]) -> Result
 /// is one, or nothing is there yet (it is created when the run starts).
 pub fn check_output_folder(dir: &Path, flag: &str) -> Result<()> {
     if dir.as_os_str() == "-" {
-        bail!("{flag} -: expected a folder; a folder of frames cannot go to standard output");
+        bail_output!(
+            "{flag} -: expected a folder; a folder of frames cannot go to standard output"
+        );
     }
     // `file/` does not exist as a path (the file is no folder), but `file` does.
     let text = dir.to_string_lossy();
     let bare = Path::new(text.trim_end_matches(['/', std::path::MAIN_SEPARATOR]));
     if (dir.exists() && !dir.is_dir()) || (bare.exists() && !bare.is_dir()) {
-        bail!("{flag} {}: is a file, expected a folder", dir.display());
+        bail_output!("{flag} {}: is a file, expected a folder", dir.display());
     }
     Ok(())
 }
