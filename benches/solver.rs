@@ -1,5 +1,5 @@
-//! Solver benches: one force evaluation, the spring loop in each compilation the CPU runs,
-//! and one step of each integrator, on the cloth-N workload
+//! Solver benches: a step in each compilation of the spring loop the CPU runs, and one
+//! step of each integrator, on the cloth-N workload
 //! (`docs/benchmarks.md`) and on a public jello world.
 //!
 //! `cargo bench -p hooke-tests --bench solver`; figures in `benches/README.md`.
@@ -10,7 +10,7 @@
 )]
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use hooke_core::{Assembly, Integrator, Kernel, Vec3};
+use hooke_core::{Integrator, Kernel};
 use hooke_scene::{Overrides, Scene};
 use std::hint::black_box;
 use std::path::Path;
@@ -43,32 +43,20 @@ fn jello(integrator: Integrator) -> Scene {
     spec.build(&root()).unwrap()
 }
 
-fn forces(c: &mut Criterion) {
-    let mut group = c.benchmark_group("forces");
-    for n in [64, 256] {
-        let scene = cloth(n, Integrator::Symplectic);
-        let (model, p) = (scene.simulation.model(), scene.simulation.particles());
-        let mut assembly = Assembly::new(p.len(), &model.springs);
-        let mut a = vec![Vec3::zeros(); p.len()];
-        group.throughput(Throughput::Elements(model.springs.len() as u64));
-        group.bench_with_input(BenchmarkId::new("cloth", n), &n, |b, _| {
-            b.iter(|| {
-                assembly.accelerations(model, (&p.mass, &p.inv_mass), (&p.x, &p.v), &[], &mut a);
-                black_box(&a);
-            })
-        });
-    }
-    // The spring loop alone, in each compilation this CPU runs.
-    let scene = cloth(256, Integrator::Symplectic);
-    let (model, p) = (scene.simulation.model(), scene.simulation.particles());
-    group.throughput(Throughput::Elements(model.springs.len() as u64));
+/// A symplectic step of cloth-256 in each compilation of the spring loop this CPU runs: the
+/// loop is most of the step, so this compares the kernels through the public API.
+fn kernels(c: &mut Criterion) {
+    let mut group = c.benchmark_group("kernels");
     for kernel in Kernel::available() {
-        let mut assembly = Assembly::new(p.len(), &model.springs);
-        assembly.set_kernel(kernel);
-        group.bench_function(BenchmarkId::new("springs-256", kernel), |b| {
+        let mut scene = cloth(256, Integrator::Symplectic);
+        scene.simulation.set_kernel(kernel).unwrap();
+        group.throughput(Throughput::Elements(
+            scene.simulation.model().springs.len() as u64
+        ));
+        group.bench_function(BenchmarkId::new("cloth-256-step", kernel), |b| {
             b.iter(|| {
-                assembly.scatter(&p.x, &p.v);
-                black_box(&assembly);
+                scene.simulation.step().unwrap();
+                black_box(&scene);
             })
         });
     }
@@ -107,6 +95,6 @@ fn steps(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = forces, steps
+    targets = kernels, steps
 }
 criterion_main!(benches);

@@ -170,7 +170,7 @@ fn lift_pushes_a_tilted_sheet_sideways_as_the_formula_says() {
     assert!((v1.x - v0.x).abs() > 5.0 * (v1.y - v0.y).abs() || (v1.y - v0.y).abs() < 1e-3);
     assert!(x1.z.abs() < 1e-12 && x0.z.abs() < 1e-12);
     // Its formula's value at the start of the fall, from the library: along -x.
-    let f = hooke_core::air::triangle_force(
+    let f = hooke_core::forces::air::triangle_force(
         RHO,
         0.0,
         1.0,

@@ -11,6 +11,7 @@ mod contact;
 mod determinism;
 mod images;
 mod large_steps;
+mod layout;
 mod oscillator;
 mod roundtrip;
 mod scenes;

@@ -272,7 +272,7 @@ fn workload(n: usize, steps: u64, integrator: Integrator, air: bool) -> Result<S
     if air {
         let f3 = |v: [f64; 3]| v.map(Finite::of);
         spec.simulation.air = Some(AirSpec {
-            density: Positive::of(hooke_core::air::SEA_LEVEL_DENSITY),
+            density: Positive::of(hooke_core::forces::air::SEA_LEVEL_DENSITY),
             wind: f3([2.0, 0.0, 1.0]),
             gust: None,
         });

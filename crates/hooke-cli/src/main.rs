@@ -3,7 +3,10 @@
 #![forbid(unsafe_code)]
 
 mod bench;
+mod check;
+mod convert;
 mod picture;
+mod risks;
 mod run;
 #[cfg(feature = "view")]
 mod view;
@@ -250,8 +253,8 @@ fn dispatch(command: Command) -> Result<ExitCode> {
             print!("{}", hooke_scene::to_toml(&spec));
             Ok(ExitCode::SUCCESS)
         }
-        Command::Check { scene, setup } => run::check(&scene, &setup),
-        Command::Convert { input, output } => run::convert(&input, &output),
+        Command::Check { scene, setup } => check::check(&scene, &setup),
+        Command::Convert { input, output } => convert::convert(&input, &output),
         Command::Bench(bench) => bench::run(&bench),
         #[cfg(feature = "view")]
         Command::View(args) => view::run(&args),

@@ -15,7 +15,8 @@ fn root() -> PathBuf {
 
 /// Where a mentioned path starts when it names something in the repository. Anything else
 /// (`out/`, `t.csv`, `mine.toml`) is an example output or the user's own file.
-const REPO_PREFIXES: [&str; 10] = [
+const REPO_PREFIXES: [&str; 11] = [
+    "examples/",
     "crates/",
     "assets/",
     "tests/",

@@ -30,44 +30,42 @@
 //!
 //! Build with `--release`: unoptimised nalgebra arithmetic is tens of times slower.
 
-pub mod air;
+// What is public is what another crate uses: the rest is `pub(crate)`, and this lint says
+// so of any `pub` item no other crate can reach.
+#![warn(unreachable_pub)]
+
+// The areas, each using only those above it: the state, what a collider is, the forces,
+// the model that holds them, the contact phase, the spring assembly and its kernels, the
+// integrators, the simulation that steps them. `tests/layout.rs` keeps it so.
 mod assembly;
 mod collider;
 pub mod contact;
-mod divergence;
-mod excerpt;
-mod force_field;
+pub mod forces;
 pub mod integrator;
-mod kernel;
 mod model;
+mod particles;
+mod simulation;
+
+// Small tools every area may use.
+mod excerpt;
 mod number;
 mod parallel;
-mod particles;
-mod renumber;
-mod response;
-mod simulation;
-mod spring;
-mod stability;
-mod summary;
-mod surface;
 
-pub use air::{AeroSurface, Air, Gust};
-pub use assembly::Assembly;
-pub use collider::{Collider, Contact, Feature};
+pub use assembly::kernel::Kernel;
+pub use collider::response::Response;
+pub use collider::{Circle, Collider, Contact, Feature};
 pub use contact::ContactStats;
-pub use contact::proximity::Circle;
-pub use divergence::Divergence;
 pub use excerpt::excerpt;
-pub use force_field::{FIELD_HALF_EXTENT, ForceField};
-pub use integrator::{Integrator, StepReport, Sym3, UnknownIntegrator, Workspace};
-pub use kernel::{Kernel, UnknownKernel};
-pub use model::{Attachment, ColliderSlot, Model, Near};
+pub use forces::air::{AeroSurface, Air, Gust};
+pub use forces::field::ForceField;
+pub use forces::spring::{Spring, SpringKind};
+pub use integrator::{Integrator, UnknownIntegrator};
+pub use model::surface::{DEFAULT_CLOTH_THICKNESS, DEFAULT_SURFACE_FRICTION, Surface};
+pub use model::{Attachment, ColliderSlot, Model};
 pub use number::Num;
 pub use particles::{Particles, SANE_BOUND, Vec3};
-pub use renumber::Renumbering;
-pub use response::Response;
+pub use simulation::divergence::Divergence;
+pub use simulation::renumber::Renumbering;
+pub use simulation::stability::StabilityEstimate;
+pub use simulation::summary::Summary;
 pub use simulation::{RenumberError, Simulation};
-pub use spring::{DEGENERATE_LENGTH, Spring, SpringKind};
-pub use stability::StabilityEstimate;
-pub use summary::Summary;
-pub use surface::{DEFAULT_CLOTH_THICKNESS, DEFAULT_SURFACE_FRICTION, Surface};

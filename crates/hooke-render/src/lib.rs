@@ -22,13 +22,15 @@
 
 mod bins;
 mod camera;
+mod downsample;
 mod draw_list;
+mod options;
 mod raster;
-mod resolve;
 mod setup;
 mod shading;
 mod tile;
 
 pub use camera::Camera;
 pub use draw_list::{DrawList, Line, Mesh, Point, Rgb, Triangle};
-pub use raster::{RenderOptions, Renderer, render};
+pub use options::RenderOptions;
+pub use raster::{Renderer, render};

@@ -4,7 +4,7 @@
 //!
 //! The pipeline: primitive setup in parallel over the draw list (projection, fixed-point
 //! corners, sample rectangles); binning into tiles in fixed chunks; then in parallel over
-//! tiles, scan conversion into a depth + primitive-id buffer and a resolve that shades each
+//! tiles, scan conversion into a depth + primitive-id buffer and a downsampling that shades each
 //! distinct primitive of a pixel once. Every tile sees its primitives in draw-list order and
 //! no two tiles share a pixel, so the picture is the same bits whatever the thread count.
 //! Attributes are interpolated perspective-correctly: barycentrics are weighted by `1/w`
@@ -12,36 +12,13 @@
 
 use crate::bins::{Bins, Grid};
 use crate::camera::Camera;
-use crate::draw_list::{DrawList, Rgb};
-use crate::resolve::Resolver;
+use crate::downsample::Downsampler;
+use crate::draw_list::DrawList;
+use crate::options::RenderOptions;
 use crate::setup::{Frame, LineSetup, PointSetup, Projected, Rect, TriSetup};
 use crate::shading::Shading;
 use crate::tile::Samples;
 use rayon::prelude::*;
-
-/// How to render.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RenderOptions {
-    /// Output width in pixels.
-    pub width: u32,
-    /// Output height in pixels.
-    pub height: u32,
-    /// Samples per pixel along each axis: 2 is 4× supersampling (the default for stills).
-    pub supersample: u32,
-    /// Background at the top and bottom of the image.
-    pub background: [Rgb; 2],
-}
-
-impl Default for RenderOptions {
-    fn default() -> Self {
-        Self {
-            width: 800,
-            height: 600,
-            supersample: 2,
-            background: [[0.80, 0.86, 0.93], [0.97, 0.97, 0.98]],
-        }
-    }
-}
 
 /// Tile side in output pixels: with 4× supersampling a tile's depth and id buffers take
 /// 128 KiB, which stays in a core's L2 cache.
@@ -166,7 +143,7 @@ impl Renderer {
         self.tri_bins.fill(&self.rects[0], &grid);
         self.line_bins.fill(&self.rects[1], &grid);
         self.point_bins.fill(&self.rects[2], &grid);
-        let resolver = Resolver {
+        let downsampler = Downsampler {
             list,
             mesh_start: &self.mesh_start,
             tris: &self.tris,
@@ -196,27 +173,27 @@ impl Renderer {
                 };
                 let bins = [tri_bins, line_bins, point_bins];
                 if bins.iter().all(|b| b.tile(t).next().is_none()) {
-                    resolver.background_tile(&area, pixels);
+                    downsampler.background_tile(&area, pixels);
                     return;
                 }
                 samples.reset(area);
                 // Binned primitives are the set-up ones: the `if let` never skips.
                 for id in tri_bins.tile(t) {
-                    if let Some(s) = &resolver.tris[id as usize] {
+                    if let Some(s) = &downsampler.tris[id as usize] {
                         samples.triangle(s, id);
                     }
                 }
                 for id in line_bins.tile(t) {
-                    if let Some(s) = &resolver.lines[id as usize] {
+                    if let Some(s) = &downsampler.lines[id as usize] {
                         samples.line(s, line_ids + id);
                     }
                 }
                 for id in point_bins.tile(t) {
-                    if let Some(s) = &resolver.points[id as usize] {
+                    if let Some(s) = &downsampler.points[id as usize] {
                         samples.point(s, point_ids + id);
                     }
                 }
-                resolver.resolve(samples, pixels);
+                downsampler.downsample(samples, pixels);
             },
         );
 

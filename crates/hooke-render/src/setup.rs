@@ -120,7 +120,7 @@ pub(crate) struct TriSetup {
     /// normal, as interpolating inside it changes nothing visible.
     pub tiny: bool,
     pub rect: Rect,
-    /// The mean corner normal and the colour, copied here because the resolve needs them
+    /// The mean corner normal and the colour, copied here because the downsampling needs them
     /// for every tiny triangle of a pixel: from the draw list that is a cache miss into
     /// hundreds of megabytes per triangle (measured: 14 % of a 2-million-triangle frame),
     /// from here a read of what the tile's scan conversion just touched.

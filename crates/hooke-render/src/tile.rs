@@ -1,7 +1,7 @@
 //! One tile of samples: depth and the id of the nearest primitive per sample, filled by the
 //! rasteriser and then resolved (shaded and averaged) into output pixels.
 //!
-//! Shading is deferred to the resolve: each output pixel shades each distinct primitive
+//! Shading is deferred to the downsampling: each output pixel shades each distinct primitive
 //! among its samples once, at the pixel centre, as multisampling does. A pixel inside one
 //! surface costs one shade however many samples it has.
 

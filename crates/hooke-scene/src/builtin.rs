@@ -313,7 +313,7 @@ pub fn flag() -> SceneSpec {
     });
     let mut simulation = sim(Integrator::Symplectic, 2.5e-4, 5.0, 120, 0.0);
     simulation.air = Some(AirSpec {
-        density: Positive::of(hooke_core::air::SEA_LEVEL_DENSITY),
+        density: Positive::of(hooke_core::forces::air::SEA_LEVEL_DENSITY),
         wind: f3([6.0, 0.0, 0.0]),
         gust: Some(GustSpec {
             amplitude: f3([2.0, 0.0, 2.5]),

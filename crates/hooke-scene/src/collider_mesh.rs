@@ -1,7 +1,7 @@
 //! Colliders as triangles, in world coordinates: what the renderer draws and what the OBJ
 //! export writes. Unbounded shapes are clipped to a region the caller chooses.
 
-use crate::build::ColliderGeometry;
+use crate::scene::ColliderGeometry;
 use hooke_collide::Cylinder;
 use hooke_core::Vec3;
 use std::f64::consts::TAU;

@@ -3,7 +3,7 @@
 //! body. The edited scene is read back through the same checks as a file, so a bad value is
 //! refused with its key.
 
-use crate::build::BuildError;
+use crate::error::BuildError;
 use crate::spec::SceneSpec;
 
 impl SceneSpec {

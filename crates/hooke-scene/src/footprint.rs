@@ -179,7 +179,7 @@ impl SceneSpec {
         }
         for (c, collider) in self.colliders.iter().enumerate() {
             if let ColliderShapeSpec::Mesh { path, .. } = &collider.shape {
-                let bytes = crate::build::mesh_file_len(path, base);
+                let bytes = crate::colliders::mesh_file_len(path, base);
                 f.mesh_file_bytes = f.mesh_file_bytes.saturating_add(bytes);
                 f.note(
                     format!("collider[{c}].shape.path"),

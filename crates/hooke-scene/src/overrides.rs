@@ -3,7 +3,7 @@
 //! own, such as the command line's flags, map them.
 
 use crate::BuildError;
-use crate::build::invalid;
+use crate::error::invalid;
 use crate::spec::*;
 
 /// What replaces a scene's table: every mesh or cylinder collider.

@@ -5,7 +5,8 @@
 //! file's line and column. Units are SI; scenes are +Y up. See `assets/scenes/*.toml` for one
 //! complete example per built-in scene.
 
-use hooke_core::{Integrator, SpringKind};
+use hooke_core::{Integrator, SpringKind, Vec3};
+use nalgebra::Rotation3;
 use serde::{Deserialize, Serialize};
 
 /// Defines a checked `f64`: a private field, so a value exists only once it passed `$ok`.
@@ -179,7 +180,7 @@ pub struct AirSpec {
 }
 
 fn sea_level() -> Positive {
-    Positive::of(hooke_core::air::SEA_LEVEL_DENSITY)
+    Positive::of(hooke_core::forces::air::SEA_LEVEL_DENSITY)
 }
 
 fn still() -> [Finite; 3] {
@@ -485,4 +486,15 @@ impl SpringsSpec {
             SpringKind::Other => None,
         }
     }
+}
+
+/// A described vector as the core's.
+pub(crate) fn vec3(v: &[Finite; 3]) -> Vec3 {
+    Vec3::new(v[0].get(), v[1].get(), v[2].get())
+}
+
+/// A rotation by Euler angles in degrees (x, y, z).
+pub(crate) fn rotation(degrees: &[Finite; 3]) -> Rotation3<f64> {
+    let r = vec3(degrees).map(f64::to_radians);
+    Rotation3::from_euler_angles(r.x, r.y, r.z)
 }

@@ -1,7 +1,7 @@
 //! The surface triangles of generated bodies: what contacts act on, what is drawn and what
 //! is exported.
 
-use crate::build::Topology;
+use crate::scene::Topology;
 
 /// The triangles of a `rows × cols` sheet whose particle at `(r, c)` is `index(r, c)`: two per
 /// grid square, split along the `(r, c)–(r+1, c+1)` diagonal, counter-clockwise seen from the

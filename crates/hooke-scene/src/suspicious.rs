@@ -3,7 +3,7 @@
 //! beside or under the table and wraps its pedestal instead of landing on it), tables of a
 //! single triangle. Said as warnings: such scenes still run.
 
-use crate::build::{ColliderGeometry, Scene};
+use crate::scene::{ColliderGeometry, Scene};
 use hooke_core::{Num, Vec3};
 
 /// The top height and horizontal extent (`[x_min, z_min]`, `[x_max, z_max]`) of a table-like

@@ -2,13 +2,22 @@
 //! tell a bad file from a divergence, a refused output or an interrupt, and prints it to
 //! say all of it (what, where, why) on one line.
 
-use crate::interrupt::Interrupted;
 use hooke_collide::MeshError;
 use hooke_core::Divergence;
 use hooke_scene::world::{InvalidWorld, WorldError};
 use hooke_scene::{BuildError, SceneError};
 use std::fmt::Display;
 use std::path::PathBuf;
+
+/// The run was interrupted: carried as an error so that every caller stops the same way.
+#[derive(Debug, thiserror::Error)]
+#[error("interrupted at step {step} (t = {} s)", hooke_core::Num(*.time))]
+pub struct Interrupted {
+    /// Steps completed.
+    pub step: u64,
+    /// Simulated time reached, seconds.
+    pub time: f64,
+}
 
 /// What went wrong in a call of this crate. Its text is complete: the context a caller
 /// added (`scene 'cloth-table'`), then the cause, then the cause's causes, joined by `: `.

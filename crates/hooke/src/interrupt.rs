@@ -16,15 +16,7 @@ pub const EXIT_INTERRUPTED: u8 = 130;
 /// Interrupts after which the process exits at once.
 const FORCE_AFTER: u32 = 3;
 
-/// The run was interrupted: carried as an error so that every caller stops the same way.
-#[derive(Debug, thiserror::Error)]
-#[error("interrupted at step {step} (t = {} s)", hooke_core::Num(*.time))]
-pub struct Interrupted {
-    /// Steps completed.
-    pub step: u64,
-    /// Simulated time reached, seconds.
-    pub time: f64,
-}
+pub use crate::error::Interrupted;
 
 /// Installs the handler (see the module's documentation).
 pub fn install() {

@@ -195,7 +195,7 @@ impl<F: Finish> Pass<'_, F> {
 pub(super) type Layout<'a> = (
     &'a super::SpringTable,
     &'a [super::Run],
-    crate::kernel::Kernel,
+    crate::assembly::kernel::Kernel,
 );
 
 impl Assembly {
@@ -300,7 +300,7 @@ impl Assembly {
 #[cfg(test)]
 mod tests {
     use crate::assembly::Assembly;
-    use crate::kernel::tests::{bits, jumble, lattice, pool};
+    use crate::assembly::kernel::tests::{bits, jumble, lattice, pool};
     use crate::particles::Vec3;
 
     /// The one-pass step updates the state in place to the bits the two-pass form gives

@@ -311,12 +311,12 @@ impl Assembly {
 #[cfg(test)]
 mod tests {
     use crate::assembly::Assembly;
+    use crate::assembly::kernel::tests::{bits, jumble, pool};
+    use crate::collider::response::Response;
     use crate::collider::{Collider, Contact};
-    use crate::kernel::tests::{bits, jumble, pool};
+    use crate::forces::spring::{Spring, SpringKind};
     use crate::model::{ColliderSlot, Model};
     use crate::particles::Vec3;
-    use crate::response::Response;
-    use crate::spring::{Spring, SpringKind};
 
     /// A penalty floor at height `y` that answers [`Collider::may_touch`].
     #[derive(Debug)]

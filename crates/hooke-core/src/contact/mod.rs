@@ -7,7 +7,7 @@
 //!
 //! 1. **Faces.** Every particle is tested against every collider with its body's thickness
 //!    as margin and put `h` out of the surface by the collider's response (restitution,
-//!    stick); see `Model::resolve_contacts`.
+//!    stick); see `respond::respond_all`.
 //! 2. **Proximities.** Collider features (mesh edges at an angle, the cylinder's rims)
 //!    nearer than `h` to a surface triangle, and particle–triangle and edge–edge pairs of
 //!    surfaces nearer than `h` (self-collision within a body, and between bodies), each give
@@ -34,14 +34,16 @@
 
 pub(crate) mod grid;
 pub mod proximity;
+mod respond;
 
 use crate::collider::Feature;
-use crate::model::{FaceSkip, Model};
+use crate::collider::response::Response;
+use crate::model::Model;
 use crate::particles::{Particles, Vec3};
-use crate::response::Response;
 use grid::Grid;
 use proximity::{circle_triangle, point_triangle, segment_segment, segment_triangle};
 use rayon::prelude::*;
+use respond::{FaceSkip, respond_all, respond_one};
 use std::time::Instant;
 
 /// Gauss–Seidel sweeps over the proximities. Proximities that the pushes create are found
@@ -175,7 +177,7 @@ struct FeaturePair {
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ContactState {
     ready: bool,
-    /// Per particle: whether a stick response holds it (see [`Model::resolve_contacts`]).
+    /// Per particle: whether a stick response holds it (see [`respond_all`]).
     /// Sized by [`ContactState::new`], before the first step, because the implicit
     /// integrator reads it.
     pub(crate) held: Vec<bool>,
@@ -853,7 +855,7 @@ fn pair(model: &Model, surface_of: &[u32], a: u32, b: u32) -> Option<(f64, f64)>
 
 /// Runs the contact phase after an integrator step: `x0` are the step's start positions.
 /// Returns whether it may have moved any particle.
-pub(crate) fn resolve(
+pub(crate) fn phase(
     model: &Model,
     p: &mut Particles,
     x0: &[Vec3],
@@ -873,7 +875,8 @@ pub(crate) fn resolve(
         state.face = vec![skip; p.len()];
     }
     let face = &mut state.face;
-    let moved = model.resolve_contacts(
+    let moved = respond_all(
+        model,
         &p.inv_mass,
         &state.margin,
         x0,
@@ -915,8 +918,16 @@ pub(crate) fn resolve(
             let i = i as usize;
             let (x, v) = (&mut p.x[i], &mut p.v[i]);
             let held = &mut state.held[i];
-            *held =
-                model.resolve_particle(p.inv_mass[i], state.margin[i], &x0[i], x, v, *held, None);
+            *held = respond_one(
+                model,
+                p.inv_mass[i],
+                state.margin[i],
+                &x0[i],
+                x,
+                v,
+                *held,
+                None,
+            );
         }
     }
     state.moved.clear();

@@ -6,6 +6,7 @@
 //! The point–triangle and segment–segment routines follow Ericson, *Real-Time Collision
 //! Detection* (2005), §5.1.5 and §5.1.9.
 
+use crate::collider::Circle;
 use crate::particles::Vec3;
 
 /// Squared lengths below this are treated as zero (degenerate segments and triangles).
@@ -170,7 +171,13 @@ fn segment_through_triangle(
 /// The closest points of segment `pq` and triangle `abc`: the segment parameter `s` and the
 /// barycentric weights of the triangle's point. Where the segment passes through the
 /// triangle, the crossing point (distance zero).
-pub fn segment_triangle(p: &Vec3, q: &Vec3, a: &Vec3, b: &Vec3, c: &Vec3) -> (f64, [f64; 3]) {
+pub(crate) fn segment_triangle(
+    p: &Vec3,
+    q: &Vec3,
+    a: &Vec3,
+    b: &Vec3,
+    c: &Vec3,
+) -> (f64, [f64; 3]) {
     if let Some(hit) = segment_through_triangle(p, q, a, b, c) {
         return hit;
     }
@@ -193,17 +200,6 @@ pub fn segment_triangle(p: &Vec3, q: &Vec3, a: &Vec3, b: &Vec3, c: &Vec3) -> (f6
     let (s, t) = segment_segment(p, q, c, a);
     keep(at(s, [t, 0.0, 1.0 - t]));
     (best.1, best.2)
-}
-
-/// A circle in space: the rim of a round tabletop.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Circle {
-    /// Centre, metres.
-    pub center: Vec3,
-    /// Unit normal of the circle's plane.
-    pub axis: Vec3,
-    /// Radius, metres.
-    pub radius: f64,
 }
 
 impl Circle {
@@ -267,7 +263,7 @@ const GOLDEN_STEPS: usize = 30;
 /// The circle is exact (not a polygon): the distance is minimised over the arc that the
 /// triangle's corners span as seen from the circle's axis (the whole circle when they
 /// surround it), by sampling and then golden-section refinement of the best sample's bracket.
-pub fn circle_triangle(circle: &Circle, a: &Vec3, b: &Vec3, c: &Vec3) -> (Vec3, [f64; 3]) {
+pub(crate) fn circle_triangle(circle: &Circle, a: &Vec3, b: &Vec3, c: &Vec3) -> (Vec3, [f64; 3]) {
     let basis = circle.basis();
     let (u, v) = basis;
     let angle = |p: &Vec3| {

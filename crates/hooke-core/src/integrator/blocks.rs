@@ -7,11 +7,11 @@ use rayon::prelude::*;
 
 /// A symmetric 3×3 matrix: `[xx, yy, zz, xy, xz, yz]`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Sym3(pub [f64; 6]);
+pub(crate) struct Sym3(pub [f64; 6]);
 
 impl Sym3 {
     /// `u uᵀ`.
-    pub fn outer(u: &Vec3) -> Self {
+    pub(crate) fn outer(u: &Vec3) -> Self {
         Self([
             u.x * u.x,
             u.y * u.y,
@@ -23,12 +23,12 @@ impl Sym3 {
     }
 
     /// `s · self`.
-    pub fn scale(self, s: f64) -> Self {
+    pub(crate) fn scale(self, s: f64) -> Self {
         Self(self.0.map(|v| v * s))
     }
 
     /// `self + s I`.
-    pub fn plus_identity(mut self, s: f64) -> Self {
+    pub(crate) fn plus_identity(mut self, s: f64) -> Self {
         for k in 0..3 {
             self.0[k] += s;
         }
@@ -36,13 +36,13 @@ impl Sym3 {
     }
 
     /// `self + other`.
-    pub fn plus(self, other: &Sym3) -> Self {
+    pub(crate) fn plus(self, other: &Sym3) -> Self {
         Self(std::array::from_fn(|k| self.0[k] + other.0[k]))
     }
 
     /// `self · v`.
     #[inline]
-    pub fn mul(&self, v: &Vec3) -> Vec3 {
+    pub(crate) fn mul(&self, v: &Vec3) -> Vec3 {
         let [xx, yy, zz, xy, xz, yz] = self.0;
         Vec3::new(
             xx * v.x + xy * v.y + xz * v.z,
@@ -52,7 +52,7 @@ impl Sym3 {
     }
 
     /// The inverse, or `None` when the matrix is singular.
-    pub fn inverse(&self) -> Option<Self> {
+    pub(crate) fn inverse(&self) -> Option<Self> {
         let [a, d, f, b, c, e] = self.0;
         // Cofactors of [[a b c] [b d e] [c e f]].
         let (ca, cb, cc) = (d * f - e * e, c * e - b * f, b * e - c * d);
@@ -78,13 +78,13 @@ impl Sym3 {
 /// so that `∂f_i/∂x_i = -Kₛ`, and the damping `Dₛ = kd u uᵀ`, `∂f_i/∂v_i = -Dₛ`. The
 /// transverse term is clamped at zero for compressed springs (Choi & Ko 2002), which keeps
 /// the implicit system positive definite.
-pub fn spring_blocks(asm: &Assembly, x: &[Vec3], out: &mut Vec<[Sym3; 2]>) {
+pub(super) fn spring_blocks(asm: &Assembly, x: &[Vec3], out: &mut Vec<[Sym3; 2]>) {
     out.resize(asm.springs(), [Sym3::default(); 2]);
     let block = |k: usize| {
         let [i, j] = asm.ends(k);
         let d = x[i] - x[j];
         let len = d.norm();
-        if len < crate::spring::DEGENERATE_LENGTH {
+        if len < crate::forces::spring::DEGENERATE_LENGTH {
             return [Sym3::default(); 2];
         }
         let u = d * (1.0 / len);

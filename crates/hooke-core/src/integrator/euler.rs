@@ -25,7 +25,7 @@ pub(super) fn step(
         model,
         (&p.mass, &p.inv_mass),
         (x, v),
-        ws.air.evaluate(model, x, v, t),
+        ws.air.evaluate(model.air.as_ref(), &model.aero, x, v, t),
         &mut ws.kv[0],
         (&mut ws.x0, &mut ws.vt),
         |start, a, xn, vn| {

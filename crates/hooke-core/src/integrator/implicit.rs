@@ -24,13 +24,13 @@ use crate::particles::{Particles, Vec3};
 pub(super) const STABILITY_RADIUS: f64 = f64::INFINITY;
 
 /// Relative residual `|r| / |b|` at which CG stops.
-pub const CG_TOLERANCE: f64 = 1e-8;
+pub(super) const CG_TOLERANCE: f64 = 1e-8;
 /// CG iterations at most per step; the step then takes the best iterate.
-pub const CG_MAX_ITERATIONS: usize = 500;
+pub(super) const CG_MAX_ITERATIONS: usize = 500;
 
 /// Buffers of the implicit step, kept between steps.
 #[derive(Clone, Debug, Default)]
-pub struct ImplicitBuffers {
+pub(crate) struct ImplicitBuffers {
     /// Per spring (assembly order): `[K, D]`.
     blocks: Vec<[Sym3; 2]>,
     /// Per spring: `dt² K + dt D`.
@@ -58,7 +58,9 @@ pub(super) fn step(
     // Forces at the current state.
     let [f0, b, dv, r] = &mut ws.kv;
     // Air is taken at the step's start and left out of the Jacobian (docs/physics.md §4).
-    let air = ws.air.evaluate(model, &p.x, &p.v, t);
+    let air = ws
+        .air
+        .evaluate(model.air.as_ref(), &model.aero, &p.x, &p.v, t);
     asm.forces(model, &p.mass, (&p.x, &p.v), air, f0, |_, f| f);
 
     // Jacobian blocks and the system's per-spring blocks.
@@ -110,7 +112,7 @@ pub(super) fn step(
     let [d, q, z, _] = &mut ws.kx;
     let system = &buffers.system;
     let mass = &p.mass;
-    let multiply = |asm: &mut crate::Assembly, from: &[Vec3], to: &mut [Vec3]| {
+    let multiply = |asm: &mut crate::assembly::Assembly, from: &[Vec3], to: &mut [Vec3]| {
         asm.scatter_pairs(|k, i, j| system[k].mul(&(from[i] - from[j])));
         asm.map_gathered(to, |i, row| {
             if fixed(i) {

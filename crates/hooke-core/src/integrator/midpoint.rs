@@ -28,7 +28,7 @@ pub(super) fn step(
         model,
         masses,
         (x, v),
-        ws.air.evaluate(model, x, v, t),
+        ws.air.evaluate(model.air.as_ref(), &model.aero, x, v, t),
         k1v,
         (&mut *xt, &mut *vt),
         |start, a, xt, vt| {
@@ -46,7 +46,8 @@ pub(super) fn step(
         model,
         masses,
         (xt, vt),
-        ws.air.evaluate(model, xt, vt, t + half),
+        ws.air
+            .evaluate(model.air.as_ref(), &model.aero, xt, vt, t + half),
         k2v,
         (&mut ws.x0, &mut ws.kx[0]),
         |start, a, xn, vn| {

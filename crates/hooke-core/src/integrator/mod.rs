@@ -12,16 +12,16 @@ mod rk4;
 mod symplectic;
 mod vbd;
 
-use crate::air::AirForces;
+use crate::assembly::kernel::Kernel;
 use crate::assembly::{Assembly, BLOCK};
-use crate::kernel::Kernel;
+use crate::forces::air::AirForces;
 use crate::model::Model;
 use crate::parallel;
 use crate::particles::{Particles, Vec3};
 use std::fmt;
 use std::str::FromStr;
 
-pub use blocks::{Sym3, spring_blocks};
+pub(crate) use blocks::Sym3;
 
 /// The integration scheme; maps 1:1 to the `--integrator` flag and the scene files' names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -112,7 +112,7 @@ impl Integrator {
     /// its solve; the explicit ones leave that to the responses); a particle past its end
     /// is not held, so `&[]` holds none. Returns what the step
     /// did that its caller's checks need to know.
-    pub fn step(
+    pub(crate) fn step(
         self,
         model: &Model,
         particles: &mut Particles,
@@ -135,7 +135,7 @@ impl Integrator {
 /// What an integrator's step reports back: whether it saved the step's start positions and,
 /// for schemes that check the state in their last pass, their verdict on it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct StepReport {
+pub(crate) struct StepReport {
     /// Whether [`Workspace::start_positions`] holds the positions at the step's start.
     /// Symplectic Euler saves them only for models with a contact phase: the copy costs a
     /// fifth of a large cloth's step.
@@ -229,7 +229,7 @@ impl Workspace {
         if let Some(kernel) = self.kernel {
             self.assembly.set_kernel(kernel);
         }
-        self.air.ensure(model, particles);
+        self.air.ensure(&model.aero, particles);
         let zero = Vec3::zeros();
         self.x0.resize(particles, zero);
         // Symplectic Euler updates the state in place and has no stages: at a million
@@ -255,7 +255,7 @@ impl Workspace {
 
     /// Positions at the start of the last step, if `report` (that step's) says they were
     /// saved.
-    pub fn start_positions(&self, report: StepReport) -> Option<&[Vec3]> {
+    pub(crate) fn start_positions(&self, report: StepReport) -> Option<&[Vec3]> {
         report.saved_start.then_some(self.x0.as_slice())
     }
 }

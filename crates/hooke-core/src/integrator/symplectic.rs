@@ -1,12 +1,12 @@
 //! Semi-implicit (symplectic) Euler: `v' = v + dt a(x, v)`, then `x' = x + dt v'`.
 //!
 //! The spring forces, their sums, the update and the divergence check are one pass over the
-//! partitions and particles ([`crate::Assembly`]'s `scatter_and_finish`): the method that
+//! partitions and particles ([`crate::assembly::Assembly`]'s `scatter_and_finish`): the method that
 //! benchmarks run streams each array about once per step. The state is updated in place;
 //! the start positions are copied aside as it goes only for a model with a contact phase.
 
 use super::{StepReport, Workspace};
-use crate::kernel::Advance;
+use crate::assembly::kernel::Advance;
 use crate::model::Model;
 use crate::parallel;
 use crate::particles::{Particles, SANE_BOUND, Vec3};
@@ -46,7 +46,9 @@ fn update<const GRAVITY_ONLY: bool>(
     ws: &mut Workspace,
     save: bool,
 ) -> bool {
-    let air = ws.air.evaluate(model, &p.x, &p.v, t);
+    let air = ws
+        .air
+        .evaluate(model.air.as_ref(), &model.aero, &p.x, &p.v, t);
     let (mass, inv_mass) = (&p.mass[..], &p.inv_mass[..]);
     let kernel = ws.assembly.kernel();
     let finish = |start: usize, springs: &[Vec3], x: &mut [Vec3], v: &mut [Vec3]| {

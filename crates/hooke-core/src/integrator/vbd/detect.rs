@@ -20,11 +20,11 @@
 use super::graph::Graph;
 use super::pairs::{Pair, Sides, feature_triangle, stencil_distance};
 use super::planes::{Plane, Touches};
+use crate::collider::response::Response;
 use crate::contact::grid::{Cell, Grid};
 use crate::contact::proximity::{point_triangle, segment_segment};
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
-use crate::response::Response;
 use rayon::prelude::*;
 use std::ops::Range;
 

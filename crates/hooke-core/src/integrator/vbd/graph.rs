@@ -133,8 +133,8 @@ impl Graph {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::forces::spring::{Spring, SpringKind};
     use crate::particles::Vec3;
-    use crate::spring::{Spring, SpringKind};
 
     #[test]
     fn no_spring_joins_two_particles_of_one_colour() {

@@ -4,10 +4,10 @@
 use super::detect::{Detection, collider_law};
 use super::graph::Graph;
 use super::pairs::stencil;
+use crate::collider::response::Response;
 use crate::integrator::Sym3;
 use crate::model::Model;
 use crate::particles::Vec3;
-use crate::response::Response;
 
 /// Tangential speeds below this are treated as sticking (friction's smoothing), m/s.
 pub(crate) const STATIC_SPEED: f64 = 1e-3;
@@ -143,7 +143,7 @@ impl Local<'_> {
             let j = nb.other as usize;
             let d = xi - x[j];
             let len = d.norm();
-            if len < crate::spring::DEGENERATE_LENGTH {
+            if len < crate::forces::spring::DEGENERATE_LENGTH {
                 continue;
             }
             let u = d / len;

@@ -32,10 +32,10 @@ use rayon::prelude::*;
 /// Block descent is implicit Euler: stable for every step.
 pub(super) const STABILITY_RADIUS: f64 = f64::INFINITY;
 /// Iterations at most per step.
-pub const MAX_ITERATIONS: usize = 24;
+pub(super) const MAX_ITERATIONS: usize = 24;
 /// The step has converged when no particle moved more than this share of the step's
 /// largest displacement in the last iteration.
-pub const TOLERANCE: f64 = 1e-4;
+pub(super) const TOLERANCE: f64 = 1e-4;
 /// Displacements below this (metres) count as converged whatever the step's scale.
 const FLOOR: f64 = 1e-10;
 /// The spectral radius assumed by the Chebyshev acceleration (0: none).
@@ -47,7 +47,7 @@ const CHUNK: usize = 256;
 
 /// Buffers of the block-descent step, kept between steps.
 #[derive(Clone, Debug, Default)]
-pub struct VbdBuffers {
+pub(crate) struct VbdBuffers {
     graph: Graph,
     detection: Detection,
     /// Inertial targets.
@@ -76,7 +76,9 @@ pub(super) fn step(
 ) -> StepReport {
     let n = p.len();
     ws.x0.copy_from_slice(&p.x);
-    let air = ws.air.evaluate(model, &p.x, &p.v, t);
+    let air = ws
+        .air
+        .evaluate(model.air.as_ref(), &model.aero, &p.x, &p.v, t);
     let b = &mut ws.vbd;
     if !b.graph.fits(n, model.springs.len()) {
         b.graph = Graph::new(model, p);

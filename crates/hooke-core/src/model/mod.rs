@@ -1,13 +1,14 @@
 //! The force model of a system: everything that is constant during a run.
 
-use crate::air::{AeroSurface, Air};
+pub(crate) mod surface;
+
+use crate::collider::response::Response;
 use crate::collider::{Collider, Contact};
-use crate::force_field::ForceField;
-use crate::parallel;
+use crate::forces::air::{AeroSurface, Air};
+use crate::forces::field::ForceField;
+use crate::forces::spring::Spring;
+use crate::model::surface::Surface;
 use crate::particles::Vec3;
-use crate::response::Response;
-use crate::spring::Spring;
-use crate::surface::Surface;
 
 /// A collider together with the response it triggers.
 #[derive(Debug)]
@@ -20,7 +21,7 @@ pub struct ColliderSlot {
 
 /// Springs, external forces and colliders, and the per-particle masses they act on.
 ///
-/// Forces are evaluated per docs/physics.md §1 by an [`crate::Assembly`], which sums them in an order
+/// Forces are evaluated per docs/physics.md §1 by the spring assembly (`assembly/`), which sums them in an order
 /// fixed by the problem, so results are the same bits however the work is split.
 #[derive(Debug, Default)]
 pub struct Model {
@@ -63,75 +64,18 @@ pub struct Attachment {
 /// Which of a model's penalty colliders may touch a group of particles (see
 /// [`Model::near`]): bit `k` for collider `k`; colliders past the 64th are always asked.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Near(u64);
+pub(crate) struct Near(u64);
 
 impl Near {
     /// Every collider may touch.
-    pub const ALL: Self = Self(u64::MAX);
+    pub(crate) const ALL: Self = Self(u64::MAX);
 
     /// Whether collider `k` may touch.
     #[inline]
-    pub fn may_touch(self, k: usize) -> bool {
+    pub(crate) fn may_touch(self, k: usize) -> bool {
         k >= 64 || self.0 >> k & 1 == 1
     }
 }
-
-/// Colliders with a velocity response whose checks [`FaceSkip`] tracks per particle; any
-/// further ones are checked every step.
-pub(crate) const FACE_SKIP_COLLIDERS: usize = 4;
-
-/// Radii of the boxes around a particle tried, largest first, for a collider it cannot
-/// touch within them (metres).
-const CLEARANCES: [f64; 3] = [0.2, 0.05, 0.0125];
-
-/// One particle's record for skipping collider checks that cannot find anything: its
-/// path length (the sum of every leg's length between checks: a bound on how far it can
-/// have moved since any earlier check), where it was at the last check, and per tracked
-/// collider the path length below which it cannot reach it (`-inf`: check).
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct FaceSkip {
-    /// `false`: check every collider every time.
-    enabled: bool,
-    path: f64,
-    last: Vec3,
-    budget: [f64; FACE_SKIP_COLLIDERS],
-}
-
-impl Default for FaceSkip {
-    fn default() -> Self {
-        Self {
-            enabled: true,
-            ..Self::NEVER
-        }
-    }
-}
-
-impl FaceSkip {
-    /// Skips nothing.
-    pub(crate) const NEVER: Self = Self {
-        enabled: false,
-        path: 0.0,
-        last: Vec3::new(f64::NAN, f64::NAN, f64::NAN),
-        budget: [f64::NEG_INFINITY; FACE_SKIP_COLLIDERS],
-    };
-
-    /// The budget after a check at `here` that found nothing: the largest of
-    /// [`CLEARANCES`] whose box around `here` the collider promises not to touch within
-    /// `margin` ([`Collider::may_touch`]), less how far `here` lies from where the path
-    /// was last counted (`counted`), and a little for rounding.
-    fn clearance(&self, shape: &dyn Collider, here: &Vec3, counted: &Vec3, margin: f64) -> f64 {
-        let shift = (here - counted).norm();
-        for r in CLEARANCES {
-            if !shape.may_touch(&here.add_scalar(-r), &here.add_scalar(r), margin) {
-                return self.path + 0.999 * r - shift - 1e-9;
-            }
-        }
-        f64::NEG_INFINITY
-    }
-}
-
-/// Particles per parallel block of collision responses.
-const CONTACT_BLOCK: usize = 256;
 
 impl Model {
     /// Whether gravity is the only force besides the springs (no field, drag, air, penalty
@@ -146,7 +90,7 @@ impl Model {
     }
 
     /// Whether any collider has a velocity-level response (restitution, stick), which
-    /// `Model::resolve_contacts` applies after each step from the step's start positions.
+    /// `contact::respond::respond_all` applies after each step from the step's start positions.
     pub fn has_contact_responses(&self) -> bool {
         self.colliders.iter().any(|c| !c.response.is_force())
     }
@@ -184,7 +128,7 @@ impl Model {
 
     /// [`Model::total_force`] asking only the penalty colliders `near` may let touch.
     #[inline]
-    pub fn total_force_near(
+    pub(crate) fn total_force_near(
         &self,
         p: usize,
         (mass, x, v): (f64, &Vec3, &Vec3),
@@ -203,7 +147,7 @@ impl Model {
     /// [`Collider::may_touch`] holds for the particles' bounding box, at the largest contact
     /// thickness of any surface. Forces computed with the answer are the same bits as
     /// without it; only the colliders' answers for particles they cannot touch are skipped.
-    pub fn near(&self, x: &[Vec3]) -> Near {
+    pub(crate) fn near(&self, x: &[Vec3]) -> Near {
         if self.colliders.iter().all(|c| !c.response.is_force()) {
             return Near::ALL;
         }
@@ -233,7 +177,7 @@ impl Model {
     /// Whether gravity is the only force besides the springs on particles whose penalty
     /// colliders are `near` (see [`Model::gravity_only`]): then [`Model::total_force_near`]
     /// is `m g + springs`, to the bit.
-    pub fn gravity_only_near(&self, near: Near) -> bool {
+    pub(crate) fn gravity_only_near(&self, near: Near) -> bool {
         self.field.is_none()
             && self.drag == 0.0
             && self.attachments.is_empty()
@@ -253,7 +197,14 @@ impl Model {
 
     /// [`Model::external_force`] asking only the penalty colliders `near` may let touch.
     #[inline]
-    pub fn external_force_near(&self, p: usize, mass: f64, x: &Vec3, v: &Vec3, near: Near) -> Vec3 {
+    pub(crate) fn external_force_near(
+        &self,
+        p: usize,
+        mass: f64,
+        x: &Vec3,
+        v: &Vec3,
+        near: Near,
+    ) -> Vec3 {
         let mut f = self.gravity * mass;
         if let Some(field) = &self.field {
             f += field.sample(x);
@@ -281,118 +232,6 @@ impl Model {
             f -= (x - a.target) * a.ks + v * a.kd;
         }
         f
-    }
-
-    /// Applies the velocity-level responses (restitution, stick) after a full step. `x0` are
-    /// the positions at the start of the step, for the crossing test of thin colliders.
-    ///
-    /// `stuck` records, per particle, whether it is held by a stick response: set when one
-    /// resolved it this step, kept while it has not moved since (the implicit integrator
-    /// holds stuck particles in place, so they are not re-detected). Explicit integrators
-    /// ignore it.
-    ///
-    /// `margin[p]` is particle `p`'s contact thickness (an empty slice: zero for all): the
-    /// responses put it that far out of the surface.
-    ///
-    /// `skips` (one per particle) lets a particle skip the colliders it provably cannot
-    /// touch (see [`FaceSkip`]; [`FaceSkip::NEVER`] checks them all): the same results, bit
-    /// for bit.
-    ///
-    /// Returns whether any response ran (the model has velocity-level colliders).
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn resolve_contacts(
-        &self,
-        inv_mass: &[f64],
-        margin: &[f64],
-        x0: &[Vec3],
-        x: &mut [Vec3],
-        v: &mut [Vec3],
-        stuck: &mut [bool],
-        skips: &mut [FaceSkip],
-    ) -> bool {
-        if !self.has_contact_responses() {
-            return false;
-        }
-        let resolve = |start: usize,
-                       x: &mut [Vec3],
-                       v: &mut [Vec3],
-                       stuck: &mut [bool],
-                       skips: &mut [FaceSkip]| {
-            for k in 0..x.len() {
-                let p = start + k;
-                let m = margin.get(p).copied().unwrap_or(0.0);
-                let (x, v) = (&mut x[k], &mut v[k]);
-                let skip = Some(&mut skips[k]).filter(|s| s.enabled);
-                stuck[k] = self.resolve_particle(inv_mass[p], m, &x0[p], x, v, stuck[k], skip);
-            }
-        };
-        // Mesh queries cost microseconds each, so even small blocks are worth sharing.
-        parallel::for_blocks4(CONTACT_BLOCK, x, v, stuck, skips, resolve);
-        true
-    }
-
-    /// The velocity-level responses for one particle with inverse mass `inv_mass` and
-    /// contact thickness `margin`, which started the step at `x0`; `stuck` is whether a stick
-    /// response held it before. Returns whether one holds it now. With `skip`, the colliders
-    /// it shows the particle cannot touch are skipped, and `skip` is kept up to date.
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn resolve_particle(
-        &self,
-        inv_mass: f64,
-        margin: f64,
-        x0: &Vec3,
-        x: &mut Vec3,
-        v: &mut Vec3,
-        stuck: bool,
-        mut skip: Option<&mut FaceSkip>,
-    ) -> bool {
-        if inv_mass == 0.0 {
-            return stuck;
-        }
-        let integrated = *x;
-        if let Some(skip) = skip.as_deref_mut() {
-            if skip.last.x.is_nan() {
-                skip.last = *x0;
-            }
-            skip.path += (x0 - skip.last).norm() + (integrated - x0).norm();
-            skip.last = integrated;
-        }
-        let mut held = stuck && *x == *x0;
-        for (c, slot) in self
-            .colliders
-            .iter()
-            .filter(|c| !c.response.is_force())
-            .enumerate()
-        {
-            let tracked = c < FACE_SKIP_COLLIDERS;
-            if tracked && skip.as_ref().is_some_and(|s| s.path < s.budget[c]) {
-                continue;
-            }
-            let here = *x;
-            let mut touched = false;
-            let mut apply = |c: Contact| {
-                touched = true;
-                slot.response.resolve(&c, x, v);
-            };
-            // With no margin this is `contacts`, the Collider contract says.
-            slot.shape.contacts_within(&here, margin, &mut apply);
-            if !touched && let Some(mut c) = slot.shape.crossing(x0, &here) {
-                touched = true;
-                c.depth += margin;
-                slot.response.resolve(&c, x, v);
-            }
-            held |= touched && matches!(slot.response, Response::Stick);
-            if let Some(skip) = skip.as_deref_mut()
-                && tracked
-            {
-                skip.budget[c] = if touched {
-                    f64::NEG_INFINITY
-                } else {
-                    skip.clearance(slot.shape.as_ref(), &here, &integrated, margin)
-                };
-            }
-        }
-        held
     }
 
     /// Total potential energy in joules: springs, gravity (zero at the origin) and penalty

@@ -1,13 +1,13 @@
 //! The group step of the run loop in AVX2 registers: four springs per instruction, the
 //! upper ends' coordinates transposed from the particles' layout to the components' by
 //! shuffles (the window they add into is by component already). Every lane does
-//! [`crate::spring::spring_formula`]'s operations in its order (no fused multiply-adds),
+//! [`crate::forces::spring::spring_formula`]'s operations in its order (no fused multiply-adds),
 //! so the bits are the portable kernel's, as a test checks.
 
 #![cfg(target_arch = "x86_64")]
 
 use super::run_loop::{GROUP, Group};
-use crate::spring::DEGENERATE_LENGTH;
+use crate::forces::spring::DEGENERATE_LENGTH;
 use std::arch::x86_64::{
     __m256d, _CMP_NLT_UQ, _mm256_add_pd, _mm256_and_pd, _mm256_blend_pd, _mm256_cmp_pd,
     _mm256_div_pd, _mm256_mul_pd, _mm256_permute2f128_pd, _mm256_set1_pd, _mm256_shuffle_pd,

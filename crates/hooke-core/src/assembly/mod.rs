@@ -12,13 +12,14 @@
 //! positions from a small, cache-resident stretch of the arrays.
 
 mod fused;
+pub(crate) mod kernel;
 mod small;
 
-use crate::kernel::{Kernel, MAX_OFFSETS, RUN_CHUNK, Run, RunArgs, ScatterArgs, Window};
+use crate::assembly::kernel::{Kernel, MAX_OFFSETS, RUN_CHUNK, Run, RunArgs, ScatterArgs, Window};
+use crate::forces::spring::Spring;
 use crate::model::{Model, Near};
 use crate::parallel;
 use crate::particles::Vec3;
-use crate::spring::Spring;
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::ops::Range;
@@ -45,7 +46,7 @@ fn partition_size(springs: usize) -> usize {
 
 /// Particles per reduction block: the gather adds external forces (a force field sample,
 /// collider queries), costly enough to share a 512-particle jelly in two.
-pub const REDUCE_BLOCK: usize = 256;
+pub(crate) const REDUCE_BLOCK: usize = 256;
 
 /// Particles per group asked at once which penalty colliders they may touch (see
 /// [`Model::near`]): a layer of a small jelly, few enough that most groups are clear of
@@ -54,7 +55,7 @@ const NEAR_BLOCK: usize = 32;
 
 /// Particles per block of the integrators' cheap per-particle updates: below this a
 /// system is updated inline, as a rayon call would cost more than the work.
-pub const BLOCK: usize = 1 << 12;
+pub(crate) const BLOCK: usize = 1 << 12;
 const _: () = assert!(BLOCK.is_multiple_of(REDUCE_BLOCK));
 
 /// The springs of a model in the solver's layout: end pairs, rest lengths (see
@@ -292,7 +293,7 @@ fn each_partition(partitions: &mut [Partition], f: impl Fn(&mut Partition) + Syn
 /// shape; a graph without such regularity is laid out as before. Both loops add every
 /// force in the sorted order's sequence, so the layout changes no bit of any result.
 #[derive(Clone, Debug, Default)]
-pub struct Assembly {
+pub(crate) struct Assembly {
     table: SpringTable,
     runs: Vec<Run>,
     partitions: Vec<Partition>,
@@ -457,7 +458,7 @@ impl Assembly {
     /// # Panics
     /// If a spring names a particle that does not exist (a builder bug, not user input: scene
     /// loaders validate indices first).
-    pub fn new(particles: usize, springs: &[Spring]) -> Self {
+    pub(crate) fn new(particles: usize, springs: &[Spring]) -> Self {
         Self::laid_out(particles, springs, Some(MIN_AVERAGE_PIECE))
     }
 
@@ -586,25 +587,25 @@ impl Assembly {
     }
 
     /// The compilation of the force loop in use: [`Kernel::detect`]'s unless set.
-    pub fn kernel(&self) -> Kernel {
+    pub(crate) fn kernel(&self) -> Kernel {
         self.kernel
     }
 
     /// Runs the force loop compiled for `kernel`, which must be one of
     /// [`Kernel::available`] (otherwise the detected one stays in use).
-    pub fn set_kernel(&mut self, kernel: Kernel) {
+    pub(crate) fn set_kernel(&mut self, kernel: Kernel) {
         if kernel <= Kernel::detect() {
             self.kernel = kernel;
         }
     }
 
     /// Whether this layout was built for `particles` particles and `springs` springs.
-    pub fn fits(&self, particles: usize, springs: usize) -> bool {
+    pub(crate) fn fits(&self, particles: usize, springs: usize) -> bool {
         self.particles == particles && self.table.ends.len() == springs
     }
 
     /// Computes every spring's force at `(x, v)` into the partition buffers.
-    pub fn scatter(&mut self, x: &[Vec3], v: &[Vec3]) {
+    pub(crate) fn scatter(&mut self, x: &[Vec3], v: &[Vec3]) {
         let layout = (&self.table, &self.runs[..], self.kernel);
         each_partition(&mut self.partitions, |part| {
             let (x, v) = part.read((x, v));
@@ -616,7 +617,7 @@ impl Assembly {
     /// lower end `i` and subtracted at `j`; [`Assembly::map_gathered`] then reads the sums.
     /// `k` indexes the assembly's own (sorted) spring order, as [`crate::integrator::spring_blocks`]
     /// does. This is how the implicit integrator multiplies by its system matrix.
-    pub fn scatter_pairs(&mut self, g: impl Fn(usize, usize, usize) -> Vec3 + Sync) {
+    pub(crate) fn scatter_pairs(&mut self, g: impl Fn(usize, usize, usize) -> Vec3 + Sync) {
         let table = &self.table;
         let scatter = |part: &mut Partition| {
             part.clear();
@@ -635,23 +636,23 @@ impl Assembly {
     }
 
     /// The end particles `[i, j]` (lower first) of the assembly's spring `k`.
-    pub fn ends(&self, k: usize) -> [usize; 2] {
+    pub(crate) fn ends(&self, k: usize) -> [usize; 2] {
         let [i, j] = self.table.ends[k];
         [i as usize, j as usize]
     }
 
     /// The number of springs.
-    pub fn springs(&self) -> usize {
+    pub(crate) fn springs(&self) -> usize {
         self.table.ends.len()
     }
 
     /// The rest length `l` of the assembly's spring `k`.
-    pub fn rest(&self, k: usize) -> f64 {
+    pub(crate) fn rest(&self, k: usize) -> f64 {
         self.table.rest.get(k)
     }
 
     /// The stiffness and damping `[ks, kd]` of the assembly's spring `k`.
-    pub fn params(&self, k: usize) -> [f64; 2] {
+    pub(crate) fn params(&self, k: usize) -> [f64; 2] {
         self.table.params(k)
     }
 
@@ -680,7 +681,7 @@ impl Assembly {
     /// Scatters at `(x, v)`, then sets `out[p] = map(p, F_p)` for every particle, `F_p` its
     /// total force, in parallel blocks. `extra` holds per-particle forces evaluated
     /// elsewhere (the air's), added to the springs'; empty for none.
-    pub fn forces(
+    pub(crate) fn forces(
         &mut self,
         model: &Model,
         mass: &[f64],
@@ -700,7 +701,11 @@ impl Assembly {
 
     /// Sets `out[p] = map(p, S_p)` for every particle, `S_p` its sum from the last scatter
     /// (the windows holding `p` added in partition order), in parallel blocks.
-    pub fn map_gathered(&self, out: &mut [Vec3], map: impl Fn(usize, Vec3) -> Vec3 + Sync + Send) {
+    pub(crate) fn map_gathered(
+        &self,
+        out: &mut [Vec3],
+        map: impl Fn(usize, Vec3) -> Vec3 + Sync + Send,
+    ) {
         let block = |start: usize, out: &mut [Vec3]| {
             self.gather_block(start, out);
             for (k, o) in out.iter_mut().enumerate() {
@@ -717,8 +722,9 @@ impl Assembly {
     }
 
     /// `a = F(x, v) / m` for every particle, with `extra` as in [`Assembly::forces`];
-    /// pinned particles get zero.
-    pub fn accelerations(
+    /// pinned particles get zero. The tests compare the small-system path with it.
+    #[cfg(test)]
+    pub(crate) fn accelerations(
         &mut self,
         model: &Model,
         (mass, inv_mass): (&[f64], &[f64]),

@@ -1,6 +1,7 @@
 //! The `Collider` trait the core owns; concrete shapes live in `hooke-collide`.
 
-use crate::contact::proximity::Circle;
+pub(crate) mod response;
+
 use crate::particles::Vec3;
 use std::fmt::Debug;
 
@@ -117,4 +118,15 @@ pub trait Collider: Debug + Send + Sync {
         self.contacts(p, &mut |c| deepest = deepest.max(c.depth));
         deepest
     }
+}
+
+/// A circle in space: the rim of a round tabletop.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Circle {
+    /// Centre, metres.
+    pub center: Vec3,
+    /// Unit normal of the circle's plane.
+    pub axis: Vec3,
+    /// Radius, metres.
+    pub radius: f64,
 }

@@ -1,19 +1,24 @@
 //! A running system: particles, model, integrator and step size, stepped with divergence checks.
 //!
 //! A step is the integrator's (which reports back a [`StepReport`]), then the contact phase,
-//! then the divergence check of [`crate::divergence`], which trusts the integrator's verdict
+//! then the divergence check of [`crate::simulation::divergence`], which trusts the integrator's verdict
 //! unless contacts moved particles after it.
 
-use crate::air::Air;
+pub(crate) mod divergence;
+pub(crate) mod renumber;
+pub(crate) mod stability;
+pub(crate) mod summary;
+
+use crate::assembly::kernel::Kernel;
 use crate::contact::{self, ContactState, ContactStats};
-use crate::divergence::{self, Divergence, StepEnd};
+use crate::forces::air::Air;
 use crate::integrator::{Integrator, StepReport, Workspace};
-use crate::kernel::Kernel;
 use crate::model::{Attachment, Model};
 use crate::parallel;
 use crate::particles::{Particles, Vec3};
-use crate::renumber::Renumbering;
-use crate::stability::StabilityEstimate;
+use divergence::{Divergence, StepEnd};
+use renumber::Renumbering;
+use stability::StabilityEstimate;
 
 /// A mass-spring system being simulated.
 ///
@@ -79,7 +84,7 @@ impl Simulation {
         let inline = particles.len() <= crate::assembly::REDUCE_BLOCK
             // One partition of springs (see `partition_size`).
             && model.springs.len() <= crate::assembly::PARTITION_MIN / 4
-            && !model.surfaces.iter().any(crate::surface::Surface::is_active);
+            && !model.surfaces.iter().any(crate::model::surface::Surface::is_active);
         Self {
             particles,
             model,
@@ -253,7 +258,7 @@ impl Simulation {
         // Block descent keeps its contacts inside its own iterations.
         let moved = self.model.has_contact_phase()
             && self.integrator != Integrator::Vbd
-            && contact::resolve(
+            && contact::phase(
                 &self.model,
                 &mut self.particles,
                 &self.workspace.x0,

@@ -48,7 +48,7 @@ pub struct Spring {
 }
 
 /// Below this length a spring has no direction and adds no force (docs/physics.md §1).
-pub const DEGENERATE_LENGTH: f64 = 1e-12;
+pub(crate) const DEGENERATE_LENGTH: f64 = 1e-12;
 
 impl Spring {
     /// The force on particle `i` (particle `j` receives its negation), exactly as docs/physics.md §1:
@@ -301,7 +301,7 @@ mod tests {
     fn both_batch_layouts_give_the_formula_s_bits() {
         // Only the AVX-512 kernel uses whole vectors, and not every CPU runs it: this checks
         // both layouts on any machine, against the one formula.
-        let mut unit = crate::kernel::unit_numbers(0x9e37_79b9_7f4a_7c15);
+        let mut unit = crate::assembly::kernel::unit_numbers(0x9e37_79b9_7f4a_7c15);
         let mut next = move || unit() - 0.5;
         let mut springs: Vec<_> = (0..999)
             .map(|k| {

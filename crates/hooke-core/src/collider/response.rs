@@ -48,7 +48,7 @@ impl Response {
     ///
     /// The particle moves by `δ n` rather than to `contact.point` so that several contacts of
     /// one collider (the faces at a box corner) compose into the nearest point of all of them.
-    pub fn resolve(&self, contact: &Contact, x: &mut Vec3, v: &mut Vec3) {
+    pub fn respond(&self, contact: &Contact, x: &mut Vec3, v: &mut Vec3) {
         match *self {
             Self::Penalty { .. } => {}
             Self::Restitution { cr, friction } => {

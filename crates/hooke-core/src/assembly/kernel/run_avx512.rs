@@ -1,13 +1,13 @@
 //! The group step of the run loop in AVX-512 registers: eight springs per instruction,
 //! the upper ends' coordinates transposed from the particles' layout to the components'
 //! by two-source permutes (the window they add into is by component already). Every lane
-//! does [`crate::spring::spring_formula`]'s operations in its order (no fused
+//! does [`crate::forces::spring::spring_formula`]'s operations in its order (no fused
 //! multiply-adds), so the bits are the portable kernel's, as a test checks.
 
 #![cfg(target_arch = "x86_64")]
 
 use super::run_loop::Group;
-use crate::spring::DEGENERATE_LENGTH;
+use crate::forces::spring::DEGENERATE_LENGTH;
 use std::arch::x86_64::{
     __m512d, __m512i, _CMP_NLT_UQ, _mm512_add_pd, _mm512_cmp_pd_mask, _mm512_div_pd,
     _mm512_maskz_mov_pd, _mm512_mul_pd, _mm512_permutex2var_pd, _mm512_set1_pd, _mm512_sqrt_pd,

@@ -2,10 +2,10 @@
 //!
 //! This is the code [`super::Kernel`] compiles once per instruction set; the layout it reads
 //! (sorted end pairs, indexed rest lengths, a `(ks, kd)` table) is built by
-//! [`crate::Assembly`].
+//! [`crate::assembly::Assembly`].
 
+use crate::forces::spring::SpringBatch;
 use crate::particles::Vec3;
-use crate::spring::SpringBatch;
 use std::ops::Range;
 
 /// Where the force loop reads a batch's rest lengths.

@@ -10,7 +10,7 @@ use crate::integrator::Integrator;
 use crate::model::Model;
 use crate::parallel;
 use crate::particles::{Particles, SANE_BOUND, Vec3};
-use crate::stability::StabilityEstimate;
+use crate::simulation::stability::StabilityEstimate;
 
 /// A run stopped because the state stopped making sense (docs/physics.md §7).
 ///

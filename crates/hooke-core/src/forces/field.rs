@@ -3,7 +3,7 @@
 use crate::particles::Vec3;
 
 /// Half the side of the cube the field covers, in metres.
-pub const FIELD_HALF_EXTENT: f64 = 2.0;
+pub(crate) const FIELD_HALF_EXTENT: f64 = 2.0;
 
 /// `r × r × r` force vectors (newtons, not accelerations) on the nodes of a grid over
 /// `[-2, 2]^3`, interpolated trilinearly; points outside are clamped to the box first.

@@ -5,9 +5,9 @@
 //! access over the whole arrays. [`Renumbering::by_locality`] finds a row-by-row order from
 //! where the particles are; [`crate::Simulation::renumber`] applies one.
 
+use crate::forces::spring::Spring;
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
-use crate::spring::Spring;
 use std::ops::Range;
 
 /// The part of `range` below `n` (a body range past the particles names none of them).

@@ -209,9 +209,9 @@ mod x86 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernel::Kernel;
-    use crate::kernel::tests::bits;
-    use crate::kernel::unit_numbers;
+    use crate::assembly::kernel::Kernel;
+    use crate::assembly::kernel::tests::bits;
+    use crate::assembly::kernel::unit_numbers;
 
     /// Every kernel the CPU runs updates to the portable loop's bits and verdict: with
     /// pinned particles, velocities of -0 (which `v + 0` would turn to +0 on a pinned one),

@@ -1,16 +1,16 @@
-//! The resolve: shading each tile's samples into output pixels, one shade per distinct
+//! The downsampling: shading each tile's samples into output pixels, one shade per distinct
 //! primitive (or lit material) of a pixel, averaged over its samples.
 
 use crate::draw_list::{DrawList, Rgb};
-use crate::raster::RenderOptions;
+use crate::options::RenderOptions;
 use crate::setup::{LineSetup, PointSetup, Rect, TriSetup};
 use crate::shading::Shading;
 use crate::tile::{EMPTY, Samples};
 use nalgebra::Vector3;
 
-/// Everything the resolve needs to shade a sample's primitive: the set-up primitives by
+/// Everything the downsampling needs to shade a sample's primitive: the set-up primitives by
 /// draw-list index, the lighting, and the samples per pixel along each axis.
-pub(crate) struct Resolver<'a> {
+pub(crate) struct Downsampler<'a> {
     pub list: &'a DrawList,
     /// [`Renderer::mesh_start`].
     pub mesh_start: &'a [usize],
@@ -31,7 +31,7 @@ enum Surface {
     Lit(Vector3<f64>, Rgb),
 }
 
-impl Resolver<'_> {
+impl Downsampler<'_> {
     /// What primitive `id` shows at the sample-space point `p`.
     fn surface(&self, id: u32, p: (f64, f64)) -> Surface {
         let id = id as usize;
@@ -90,7 +90,7 @@ impl Resolver<'_> {
     }
 
     /// The background of a tile that no primitive touches, row-major over the tile: what
-    /// [`Resolver::resolve`] gives for it, without clearing and reading its samples (most
+    /// [`Downsampler::downsample`] gives for it, without clearing and reading its samples (most
     /// tiles of a still where the subject fills a third of the frame).
     pub fn background_tile(&self, area: &Rect, out: &mut Vec<u8>) {
         let ((_, py0), (w, h)) = self.pixels_of(area);
@@ -105,7 +105,7 @@ impl Resolver<'_> {
     }
 
     /// Shades and averages the tile's samples into RGBA8 pixels, row-major over the tile.
-    pub fn resolve(&self, s: &Samples, out: &mut Vec<u8>) {
+    pub fn downsample(&self, s: &Samples, out: &mut Vec<u8>) {
         let ss = self.supersample; // samples per pixel along each axis
         let ((px0, py0), (w, h)) = self.pixels_of(&s.area);
         let weight = 1.0 / (ss * ss) as f32;

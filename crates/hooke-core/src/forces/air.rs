@@ -16,7 +16,6 @@
 //! The evaluation is deterministic on any thread count: each triangle's force is computed on
 //! its own, then each particle adds its triangles' thirds in ascending triangle order.
 
-use crate::model::Model;
 use crate::parallel;
 use crate::particles::Vec3;
 
@@ -143,13 +142,12 @@ pub struct AirForces {
 impl AirForces {
     /// Builds the incidences of `model`'s aero surfaces over `particles` particles, unless
     /// they already fit.
-    pub(crate) fn ensure(&mut self, model: &Model, particles: usize) {
-        let count: usize = model.aero.iter().map(|s| s.triangles.len()).sum();
+    pub(crate) fn ensure(&mut self, aero: &[AeroSurface], particles: usize) {
+        let count: usize = aero.iter().map(|s| s.triangles.len()).sum();
         if self.built_for == (particles, count) && self.start.len() == particles + 1 {
             return;
         }
-        self.triangles = model
-            .aero
+        self.triangles = aero
             .iter()
             .enumerate()
             .flat_map(|(s, surface)| surface.triangles.iter().map(move |&t| (t, s as u32)))
@@ -182,15 +180,22 @@ impl AirForces {
     /// The air force on every particle at state `(x, v)` and time `t`, or an empty slice
     /// when the model has no air (so callers add nothing, and results without air keep
     /// their bits).
-    pub(crate) fn evaluate(&mut self, model: &Model, x: &[Vec3], v: &[Vec3], t: f64) -> &[Vec3] {
-        let Some(air) = &model.air else {
+    pub(crate) fn evaluate(
+        &mut self,
+        air: Option<&Air>,
+        aero: &[AeroSurface],
+        x: &[Vec3],
+        v: &[Vec3],
+        t: f64,
+    ) -> &[Vec3] {
+        let Some(air) = air else {
             return &[];
         };
         if self.triangles.is_empty() {
             return &[];
         }
         let wind = air.wind_at(t);
-        let (triangles, aero) = (&self.triangles, &model.aero);
+        let triangles = &self.triangles;
         parallel::for_each(&mut self.thirds, |k, third| {
             let ([a, b, c], s) = triangles[k];
             let (a, b, c) = (a as usize, b as usize, c as usize);

@@ -29,8 +29,8 @@ pub(crate) use batch_choice::unit_numbers;
 pub(crate) use force_loop::{RestLookup, ScatterArgs, Window};
 pub(crate) use run_loop::{MAX_OFFSETS, RUN_CHUNK, Run, RunArgs};
 
+use crate::forces::spring::{ComponentBatch, VectorBatch};
 use crate::particles::Vec3;
-use crate::spring::{ComponentBatch, VectorBatch};
 use force_loop::{LANES, scatter_springs};
 use run_loop::{GROUP, group_by_lane, scatter_runs};
 use std::fmt;
@@ -299,8 +299,8 @@ pub(crate) fn runs_avx512_eight<const UNIFORM: bool, R: RestLookup>(args: RunArg
 pub(crate) mod tests {
     use super::*;
     use crate::assembly::Assembly;
+    use crate::forces::spring::{Spring, SpringKind};
     use crate::particles::Vec3;
-    use crate::spring::{Spring, SpringKind};
 
     /// Each vector's components as bits, for comparing results to the bit.
     pub(crate) fn bits(a: &[Vec3]) -> Vec<[u64; 3]> {

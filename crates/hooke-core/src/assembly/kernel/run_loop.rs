@@ -4,7 +4,7 @@
 //! A run needs no end indices: its springs read two contiguous stretches of positions and
 //! velocities and add their forces into two contiguous stretches of the window, so every
 //! load and store moves whole vectors and the prefetcher sees plain streams. Meshes built
-//! row by row (grids, extruded shapes, the jelly) are mostly runs; [`crate::Assembly`] finds
+//! row by row (grids, extruded shapes, the jelly) are mostly runs; [`crate::assembly::Assembly`] finds
 //! them and leaves the rest to [`super::force_loop`].
 //!
 //! Springs go in groups of four (eight with AVX-512): the vector kernels load the upper
@@ -19,7 +19,7 @@
 //! AVX-512 kernel times both (`batch_choice.rs`).
 
 use super::force_loop::RestLookup;
-use crate::spring::spring_formula;
+use crate::forces::spring::spring_formula;
 
 /// Lower ends per chunk of runs: the layout cuts runs where their lower ends cross a
 /// multiple of it, and the loop handles one chunk's pieces together. Longer pieces spread

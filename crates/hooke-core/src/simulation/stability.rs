@@ -6,11 +6,11 @@
 //! iteration from a fixed start vector, so the estimate is deterministic. Penalty colliders add
 //! `kc` to every particle's diagonal, a bound for the particles that touch them.
 
+use crate::collider::response::Response;
 use crate::integrator::Integrator;
 use crate::model::Model;
 use crate::parallel;
 use crate::particles::{Particles, Vec3};
-use crate::response::Response;
 
 /// The highest angular frequency of a system and the explicit step limits it implies.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -128,7 +128,7 @@ fn apply(model: &Model, p: &Particles, penalty_k: f64, u: &[Vec3], out: &mut [Ve
         let len = d.norm();
         // Degenerate springs have no direction; neither do springs at a particle that has
         // overflowed (a diverged state rebuilt by undoing the step).
-        if !(len >= crate::spring::DEGENERATE_LENGTH && len.is_finite()) {
+        if !(len >= crate::forces::spring::DEGENERATE_LENGTH && len.is_finite()) {
             continue;
         }
         let dir = d / len;

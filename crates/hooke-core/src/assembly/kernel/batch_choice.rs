@@ -1,7 +1,7 @@
 //! Which batch layout the AVX-512 per-spring loop uses, and how many springs its run loop
 //! takes per group, each chosen by timing both on this CPU.
 //!
-//! The two layouts (see `crate::spring`) give the same bits, but which is faster depends
+//! The two layouts (see `crate::forces::spring`) give the same bits, but which is faster depends
 //! on the microarchitecture, by more than a rule on the instruction set can capture:
 //! `VectorBatch` ran cloth-256 7 % faster than `ComponentBatch` on a Zen 5, while on a Zen 4
 //! it made a `jello.w` RK4 step 40 % slower (median 150 µs against 104 µs, 2 threads).

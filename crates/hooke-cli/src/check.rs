@@ -1,0 +1,80 @@
+//! `hooke check`: the highest frequency of a scene and the largest stable step per
+//! integrator, with what its step risks.
+
+use crate::SetupArgs;
+use crate::risks::{large_step_advice, thin_surfaces, tunnelling, warn_if_unstable};
+use anyhow::Result;
+use hooke::source;
+use hooke_core::Integrator;
+use hooke_core::Num;
+use std::process::ExitCode;
+
+pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
+    let scene = source::build(arg, &setup.overrides()?)?;
+    let sim = &scene.simulation;
+    let estimate = warn_if_unstable(&scene);
+    println!(
+        "scene {}: {} particles, {} springs",
+        scene.spec.name,
+        sim.particles().len(),
+        sim.model().springs.len()
+    );
+    println!(
+        "highest angular frequency ω_max ≈ {:.4e} rad/s (power iteration on M⁻¹K)",
+        estimate.omega_max
+    );
+    println!(
+        "scene step: dt = {} s with {}",
+        Num(sim.dt()),
+        sim.integrator()
+    );
+    for integrator in Integrator::ALL {
+        let limit = estimate.max_dt(integrator);
+        let mark = if integrator == sim.integrator() {
+            "  <- scene"
+        } else {
+            ""
+        };
+        let line = match integrator {
+            _ if !limit.is_finite() => {
+                "stable for any dt (accuracy still wants small steps)".to_string()
+            }
+            // Their amplification factor exceeds 1 for every undamped mode at every dt.
+            Integrator::Euler | Integrator::Midpoint => format!(
+                "grows undamped oscillation at any dt; with enough damping, dt < {limit:.3e} s"
+            ),
+            _ => format!("stable for dt < {limit:.3e} s"),
+        };
+        println!("  {:<11} {line}{mark}", integrator.name());
+    }
+    let dt = sim.dt();
+    if let Some(advice) = large_step_advice(&scene, &estimate) {
+        println!("{advice}");
+    }
+    if sim.integrator() == Integrator::Vbd {
+        println!(
+            "contacts: vbd bounds every update, so no surface crosses a collider or another \
+             surface at any dt (docs/physics.md §4.1)"
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    for t in tunnelling(&scene) {
+        if t.risky() {
+            println!(
+                "warning: tunnelling: {}; keep dt below {:.3e} s",
+                t.describe(dt),
+                t.safe_dt
+            );
+        } else {
+            println!(
+                "thin collider: {}: no tunnelling below dt = {:.3e} s",
+                t.describe(dt),
+                t.safe_dt
+            );
+        }
+    }
+    for message in thin_surfaces(&scene) {
+        println!("warning: tunnelling: {message}");
+    }
+    Ok(ExitCode::SUCCESS)
+}

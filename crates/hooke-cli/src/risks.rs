@@ -1,0 +1,179 @@
+//! What a scene's step risks, said before it runs: instability, tunnelling through a
+//! thin surface, and a step so small that block descent would do better.
+
+use hooke_core::Num;
+use hooke_core::{Integrator, StabilityEstimate};
+use hooke_scene::Scene;
+
+/// Warns on stderr when the scene's step exceeds the estimated stable step.
+pub(crate) fn warn_if_unstable(scene: &Scene) -> StabilityEstimate {
+    let sim = &scene.simulation;
+    let estimate = sim.stability();
+    let limit = estimate.max_dt(sim.integrator());
+    if sim.dt() > limit {
+        eprintln!(
+            "warning: dt = {} s exceeds the estimated stable step of {} ({limit:.3e} s, ω_max = {:.4e} rad/s); the run may diverge",
+            Num(sim.dt()),
+            sim.integrator(),
+            estimate.omega_max
+        );
+    }
+    estimate
+}
+
+/// One thin collider against the fastest motion the scene can reach.
+pub(crate) struct Tunnelling {
+    collider: String,
+    thickness: f64,
+    speed: f64,
+    drop: f64,
+    per_step: f64,
+    /// The largest step that keeps a step's travel within half the thickness.
+    pub(crate) safe_dt: f64,
+}
+
+/// For every collider with a finite thickness: how far the fastest particle moves in one
+/// step. The speed is the larger of the fastest particle now and a free fall from the
+/// highest particle to the ground (or the lowest particle): what a falling cloth reaches.
+pub(crate) fn tunnelling(scene: &Scene) -> Vec<Tunnelling> {
+    let sim = &scene.simulation;
+    let model = sim.model();
+    let (speed, drop) = fastest(scene);
+    model
+        .colliders
+        .iter()
+        .filter_map(|slot| {
+            // A collider without thickness (an open sheet) is held by the crossing test,
+            // not by depth: nothing to tunnel through.
+            let thickness = slot.shape.thickness().filter(|t| *t > 0.0)?;
+            Some(Tunnelling {
+                collider: slot.shape.name(),
+                thickness,
+                speed,
+                drop,
+                per_step: speed * sim.dt(),
+                safe_dt: if speed > 0.0 {
+                    0.5 * thickness / speed
+                } else {
+                    f64::INFINITY
+                },
+            })
+        })
+        .collect()
+}
+
+impl Tunnelling {
+    pub(crate) fn risky(&self) -> bool {
+        self.per_step > 0.5 * self.thickness
+    }
+
+    pub(crate) fn describe(&self, dt: f64) -> String {
+        format!(
+            "{} is {:.1} mm thick at its thinnest; at {:.2} m/s (a fall of {:.2} m) a particle moves \
+             {:.1} mm per step of {} s",
+            self.collider,
+            self.thickness * 1e3,
+            self.speed,
+            self.drop,
+            self.per_step * 1e3,
+            Num(dt)
+        )
+    }
+}
+
+/// The fastest a particle can move, m/s: the larger of the fastest now and a free fall from
+/// the highest particle to the ground (or the lowest particle); and that fall's height.
+fn fastest(scene: &Scene) -> (f64, f64) {
+    let sim = &scene.simulation;
+    let p = sim.particles();
+    let top = p.x.iter().map(|x| x.y).fold(f64::NEG_INFINITY, f64::max);
+    let mut bottom = p.x.iter().map(|x| x.y).fold(f64::INFINITY, f64::min);
+    for c in &scene.colliders {
+        if let hooke_scene::ColliderGeometry::Ground(h) = c {
+            bottom = bottom.min(*h);
+        }
+    }
+    let drop = (top - bottom).max(0.0);
+    let fall = (2.0 * sim.model().gravity.norm() * drop).sqrt();
+    let now = p.v.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    (fall.max(now), drop)
+}
+
+/// Below this explicit step (a tenth of a 60 Hz frame) `hooke check` recommends block
+/// descent for a scene with contact surfaces.
+const TINY_STEP: f64 = 1.0 / 600.0;
+
+/// The recommendation of `hooke check` for a scene with contact surfaces stepped by an
+/// explicit integrator whose stable step (or tunnelling-safe step) is tiny: block descent at
+/// a display frame.
+pub(crate) fn large_step_advice(scene: &Scene, estimate: &StabilityEstimate) -> Option<String> {
+    let sim = &scene.simulation;
+    if sim.integrator() == Integrator::Vbd || !scene.bodies.iter().any(|b| b.thickness > 0.0) {
+        return None;
+    }
+    // The stable explicit step, and the step that keeps two layers closing at the fastest
+    // speed from covering a thickness (the explicit contact phase's condition).
+    let (speed, _) = fastest(scene);
+    let layers = scene
+        .bodies
+        .iter()
+        .filter(|b| b.thickness > 0.0 && speed > 0.0)
+        .map(|b| b.thickness / (2.0 * speed))
+        .fold(f64::INFINITY, f64::min);
+    let limit = estimate.max_dt(Integrator::Symplectic).min(layers);
+    if limit >= TINY_STEP {
+        return None;
+    }
+    Some(format!(
+        "recommendation: explicit steps here must stay below {limit:.3e} s ({:.0} steps per \
+         simulated second); `--integrator vbd --dt 0.016666666666666666` takes one implicit \
+         step per 60 Hz frame with no crossing (docs/physics.md §4.1)",
+        1.0 / limit
+    ))
+}
+
+/// For each body with a contact thickness: a message when two of its layers, closing at
+/// twice the fastest speed, can cover the thickness in one step, so that a proximity is not
+/// seen before a crossing (`docs/physics.md` §3.3), with the largest safe step.
+pub(crate) fn thin_surfaces(scene: &Scene) -> Vec<String> {
+    let dt = scene.simulation.dt();
+    let (speed, _) = fastest(scene);
+    scene
+        .bodies
+        .iter()
+        .filter(|b| b.thickness > 0.0 && 2.0 * speed * dt > b.thickness)
+        .map(|b| {
+            format!(
+                "body '{}': two layers closing at {:.2} m/s move {:.1} mm per step of {} s, more \
+                 than its contact thickness of {:.1} mm, so they can cross unseen; use dt below \
+                 {:.3e} s or a larger thickness",
+                b.name,
+                2.0 * speed,
+                2.0 * speed * dt * 1e3,
+                Num(dt),
+                b.thickness * 1e3,
+                b.thickness / (2.0 * speed)
+            )
+        })
+        .collect()
+}
+
+/// Warns on stderr about thin colliders a particle can cross in one step. Block descent
+/// bounds every update so that nothing crosses whatever the step: no warning for it.
+pub(crate) fn warn_if_tunnelling(scene: &Scene) {
+    if scene.simulation.integrator() == Integrator::Vbd {
+        return;
+    }
+    let dt = scene.simulation.dt();
+    for t in tunnelling(scene).iter().filter(|t| t.risky()) {
+        eprintln!(
+            "warning: {}: more than half its thickness, so a particle can pass through or be \
+             pushed out the far side (tunnelling); use dt below {:.3e} s",
+            t.describe(dt),
+            t.safe_dt
+        );
+    }
+    for message in thin_surfaces(scene) {
+        eprintln!("warning: {message}");
+    }
+}

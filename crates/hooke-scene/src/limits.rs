@@ -1,0 +1,27 @@
+//! The largest scene and run accepted: beyond these a typo, not a wish, is the likely
+//! cause, and memory or patience would run out before anything useful happened.
+
+use crate::spec::ShapeSpec;
+
+/// Most particles a scene may have (2048²): beyond this a typo (an extra zero in a size)
+/// would exhaust memory before anything useful happened. A lattice this large carries about
+/// 13 springs per particle, some 3 GB with the solver's buffers.
+pub const MAX_PARTICLES: usize = 1 << 22;
+
+/// Most steps a run may take: a billion steps is half an hour of the 12-bead chain and days
+/// of the cloth on the table; more is a mistake in `steps`, `duration` or `dt`.
+pub const MAX_STEPS: u64 = 1_000_000_000;
+
+/// Particles a shape will have, or `None` when the count overflows.
+pub(crate) fn particle_count(shape: &ShapeSpec) -> Option<usize> {
+    match shape {
+        ShapeSpec::Chain { count, .. } => Some(*count),
+        ShapeSpec::Grid { size, .. } => size[0].checked_mul(size[1]),
+        ShapeSpec::Lattice { size, .. } => size[0].checked_mul(size[1])?.checked_mul(size[2]),
+        ShapeSpec::Points { positions } => Some(positions.len()),
+    }
+}
+
+/// The fastest wind a scene may blow, m/s: the speed of sound in air at 20 °C. The air
+/// model is incompressible pressure drag, which means nothing at or beyond it.
+pub const MAX_WIND: f64 = 343.0;

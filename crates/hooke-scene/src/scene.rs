@@ -1,0 +1,67 @@
+//! What building a description gives: the scene ready to step, its bodies and the
+//! geometry of its colliders for drawing.
+
+use crate::spec::SceneSpec;
+use hooke_collide::{BoxInterior, Cylinder};
+use hooke_core::{Simulation, Vec3};
+use std::ops::Range;
+
+/// How a body's particles are arranged, for drawing surfaces and picking subsets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Topology {
+    /// A chain of particles.
+    Chain,
+    /// A cloth grid `[nx, nz]`.
+    Grid([usize; 2]),
+    /// A jelly lattice `[nx, ny, nz]`.
+    Lattice([usize; 3]),
+    /// Unstructured points.
+    Points,
+}
+
+/// A body of a built scene: its name, where its particles are, how they are arranged.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    /// Name from the scene file.
+    pub name: String,
+    /// Its particles' indices in the simulation.
+    pub range: Range<usize>,
+    /// Arrangement.
+    pub topology: Topology,
+    /// Surface triangles as simulation particle indices (empty for chains and points).
+    pub triangles: Vec<[u32; 3]>,
+    /// Contact thickness of the surface, metres (zero: bare per-particle contacts, docs/physics.md §3.3).
+    pub thickness: f64,
+}
+
+/// The geometry of a collider, for drawing.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ColliderGeometry {
+    /// The ground plane at this height.
+    Ground(f64),
+    /// An inclined plane `[a, b, c, d]`.
+    Plane([f64; 4]),
+    /// The free box interior.
+    Box(BoxInterior),
+    /// An analytic cylinder tabletop.
+    Cylinder(Cylinder),
+    /// A triangle mesh, as world-space triangles.
+    Mesh(Vec<[Vec3; 3]>),
+}
+
+/// A scene ready to run: the simulation at step 0 and what is needed to run and draw it.
+#[derive(Debug)]
+pub struct Scene {
+    /// The description it was built from.
+    pub spec: SceneSpec,
+    /// The simulation at step 0.
+    pub simulation: Simulation,
+    /// Steps in a full run.
+    pub steps: u64,
+    /// A frame every this many steps.
+    pub every: u64,
+    /// The bodies.
+    pub bodies: Vec<Body>,
+    /// Collider geometry, in the order of the scene file.
+    pub colliders: Vec<ColliderGeometry>,
+}
