@@ -1,7 +1,8 @@
 //! The contact model checked from outside: frames exported as OBJ files are read back with
 //! tobj, and no cloth triangle may cross a collider triangle or another cloth triangle it
-//! shares no corner with. The crossing test is written here from scratch (signed volumes),
-//! independent of the solver's proximity code.
+//! shares no corner with. The crossing test (`hooke::report::crossings`, which `hooke
+//! report` runs too) is written from signed volumes, independent of the solver's proximity
+//! code.
 
 use crate::common::{builtin, root};
 use hooke::Sink;
@@ -10,44 +11,7 @@ use hooke_core::{Integrator, Model, Particles, Simulation, Surface, Vec3, contac
 use hooke_scene::Overrides;
 use std::path::{Path, PathBuf};
 
-type Tri = [Vec3; 3];
-
-/// `(b - a) × (c - a) · (d - a)`: positive when `d` is on the side the triangle `abc` faces.
-fn orient(a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3) -> f64 {
-    (b - a).cross(&(c - a)).dot(&(d - a))
-}
-
-/// Whether segment `pq` passes through the inside of triangle `t` (touching is not crossing:
-/// such configurations have measure zero, and the thickness keeps cloth far from them).
-fn segment_crosses(p: &Vec3, q: &Vec3, t: &Tri) -> bool {
-    let (sp, sq) = (
-        orient(&t[0], &t[1], &t[2], p),
-        orient(&t[0], &t[1], &t[2], q),
-    );
-    if !((sp > 0.0 && sq < 0.0) || (sp < 0.0 && sq > 0.0)) {
-        return false;
-    }
-    let e = [
-        orient(p, q, &t[0], &t[1]),
-        orient(p, q, &t[1], &t[2]),
-        orient(p, q, &t[2], &t[0]),
-    ];
-    e.iter().all(|&s| s > 0.0) || e.iter().all(|&s| s < 0.0)
-}
-
-/// Two triangles cross when an edge of one passes through the other.
-fn triangles_cross(a: &Tri, b: &Tri) -> bool {
-    (0..3).any(|k| segment_crosses(&a[k], &a[(k + 1) % 3], b))
-        || (0..3).any(|k| segment_crosses(&b[k], &b[(k + 1) % 3], a))
-}
-
-fn bounds(t: &Tri) -> (Vec3, Vec3) {
-    (t[0].inf(&t[1]).inf(&t[2]), t[0].sup(&t[1]).sup(&t[2]))
-}
-
-fn overlap(a: &(Vec3, Vec3), b: &(Vec3, Vec3)) -> bool {
-    (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
-}
+use hooke::report::crossings::{self, Tri};
 
 /// One exported frame: the cloth triangles with their corner indices, and the colliders'.
 pub(crate) struct Frame {
@@ -87,36 +51,7 @@ fn read_frame(path: &Path) -> Frame {
 
 /// Crossings in one frame: (cloth–collider, cloth–cloth) pair counts.
 pub(crate) fn crossings(frame: &Frame) -> (usize, usize) {
-    let cloth_boxes: Vec<_> = frame.cloth.iter().map(|(t, _)| bounds(t)).collect();
-    let mut against_colliders = 0;
-    for c in &frame.colliders {
-        let cb = bounds(c);
-        for (k, (t, _)) in frame.cloth.iter().enumerate() {
-            if overlap(&cb, &cloth_boxes[k]) && triangles_cross(t, c) {
-                against_colliders += 1;
-            }
-        }
-    }
-    // Cloth against cloth: a sweep along x over the boxes.
-    let mut order: Vec<usize> = (0..frame.cloth.len()).collect();
-    order.sort_by(|&a, &b| cloth_boxes[a].0.x.total_cmp(&cloth_boxes[b].0.x));
-    let mut among_cloth = 0;
-    for (i, &a) in order.iter().enumerate() {
-        for &b in &order[i + 1..] {
-            if cloth_boxes[b].0.x > cloth_boxes[a].1.x {
-                break;
-            }
-            let (ta, ia) = &frame.cloth[a];
-            let (tb, ib) = &frame.cloth[b];
-            if ia.iter().any(|v| ib.contains(v)) {
-                continue;
-            }
-            if overlap(&cloth_boxes[a], &cloth_boxes[b]) && triangles_cross(ta, tb) {
-                among_cloth += 1;
-            }
-        }
-    }
-    (against_colliders, among_cloth)
+    crossings::count(&frame.cloth, &frame.colliders)
 }
 
 /// Runs built-in `name` with `overrides` to its end, exporting every frame into a fresh
@@ -227,9 +162,9 @@ fn the_crossing_check_sees_crossings() {
         Vec3::new(0.3, 0.5, 0.3),
     ];
     let above = flat.map(|p| p + Vec3::new(0.0, 0.004, 0.0));
-    assert!(triangles_cross(&flat, &through));
-    assert!(!triangles_cross(&flat, &above));
-    assert!(!triangles_cross(
+    assert!(crossings::triangles_cross(&flat, &through));
+    assert!(!crossings::triangles_cross(&flat, &above));
+    assert!(!crossings::triangles_cross(
         &above,
         &through.map(|p| p + Vec3::new(5.0, 0.0, 0.0))
     ));

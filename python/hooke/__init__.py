@@ -9,7 +9,8 @@
 `load` takes a built-in scene (`scenes()`), a `.toml` scene or a `.w` jello world, with the
 `hooke` command's overrides. A `Simulation` steps with the command's own code, so its
 trajectory is the command's, bit for bit. `sweep` runs a scene over a grid of parameters,
-in local processes or as Ray tasks.
+in local processes or as Ray tasks. `report(dir)` runs the checks of `hooke report` and
+writes their page.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ import os
 from typing import Any, Callable, Iterable, Mapping, Optional, Sequence
 
 from . import metrics
-from ._hooke import DivergenceError, HookeError, Simulation, load
+from ._hooke import DivergenceError, HookeError, Simulation, load, report
 from ._hooke import scenes as _scenes
 
 __all__ = [
@@ -30,6 +31,7 @@ __all__ = [
     "Simulation",
     "load",
     "metrics",
+    "report",
     "scenes",
     "sweep",
     "LOAD_OPTIONS",

@@ -1,5 +1,7 @@
 """Type stubs of the extension module `hooke._hooke` (re-exported by `hooke`)."""
 
+import os
+
 from typing import Optional
 
 import numpy as np
@@ -80,3 +82,4 @@ def load(
     """A built-in scene, .toml scene or .w world, with the command line's overrides."""
 
 def scenes() -> list[tuple[str, str]]: ...
+def report(dir: str | os.PathLike[str], *, quick: bool = False) -> tuple[str, list[str]]: ...

@@ -553,12 +553,28 @@ fn scenes() -> Vec<(String, String)> {
         .collect()
 }
 
+/// Runs the checks of `hooke report` and writes the page into `dir`: `dir/index.html`,
+/// its plots, and every number in `dir/report.json`. Returns the page's path and the
+/// failed checks (empty when all passed). Runs without the GIL.
+#[pyfunction]
+#[pyo3(signature = (dir, *, quick = false))]
+fn report(py: Python<'_>, dir: std::path::PathBuf, quick: bool) -> PyResult<(String, Vec<String>)> {
+    let outcome = py
+        .detach(|| hooke::report::write(&dir, &hooke::report::Options { quick }))
+        .map_err(error)?;
+    Ok((
+        outcome.page.to_string_lossy().into_owned(),
+        outcome.failures,
+    ))
+}
+
 /// Hooke: mass-spring simulation you can trust.
 #[pymodule]
 fn _hooke(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Simulation>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(scenes, m)?)?;
+    m.add_function(wrap_pyfunction!(report, m)?)?;
     m.add("HookeError", m.py().get_type::<HookeError>())?;
     m.add("DivergenceError", m.py().get_type::<DivergenceError>())?;
     Ok(())

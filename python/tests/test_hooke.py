@@ -8,6 +8,7 @@ sets it, or `hooke` on the PATH.
 """
 
 import csv
+import json
 import os
 import shutil
 import signal
@@ -263,3 +264,16 @@ def test_the_ray_example_runs_and_plots(tmp_path):
     assert result.returncode == 0, result.stderr[-2000:]
     assert out.stat().st_size > 10_000
     assert "round" in result.stdout and "square" in result.stdout
+
+
+def test_report_writes_the_page_and_its_numbers(tmp_path):
+    page, failures = hooke.report(tmp_path / "report", quick=True)
+    assert failures == []
+    assert Path(page) == tmp_path / "report" / "index.html"
+    text = Path(page).read_text()
+    assert "Every check passed" in text
+    numbers = json.loads((tmp_path / "report" / "report.json").read_text())
+    orders = {s["integrator"]: (s["slope"], s["expected"]) for s in numbers["convergence"]}
+    assert set(orders) == {"euler", "symplectic", "midpoint", "rk4", "implicit", "vbd"}
+    for name, (slope, expected) in orders.items():
+        assert abs(slope - expected) <= 0.1, (name, slope, expected)

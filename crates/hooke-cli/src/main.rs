@@ -6,6 +6,7 @@ mod bench;
 mod check;
 mod convert;
 mod picture;
+mod report;
 mod risks;
 mod run;
 #[cfg(feature = "view")]
@@ -43,6 +44,16 @@ enum Command {
         out: PathBuf,
         #[command(flatten)]
         view: ViewArgs,
+    },
+    /// Run the checks that show the physics is right (convergence, closed forms, energy,
+    /// goldens, contacts, worlds, determinism, speed) and write them as a page:
+    /// DIR/index.html with its plots, and every number in DIR/report.json.
+    Report {
+        /// Output folder.
+        dir: PathBuf,
+        /// Shorter sweeps and runs and the three quickest scenes: under half a minute.
+        #[arg(long)]
+        quick: bool,
     },
     /// List the built-in scenes.
     Scenes,
@@ -242,6 +253,7 @@ fn dispatch(command: Command) -> Result<ExitCode> {
         Command::Run(args) => run::run(&args),
         Command::Render(args) => picture::render(&args),
         Command::Demo { out, view } => picture::demo(&out, &view.view()),
+        Command::Report { dir, quick } => report::report(&dir, quick),
         Command::Scenes => {
             for (name, make) in hooke_scene::builtin::BUILTINS {
                 println!("{name:<14} {}", make().description);

@@ -30,6 +30,8 @@
 //! ## Features
 //!
 //! * `export-usd` (default): the USD (`.usda`) export.
+//! * `report` (default): [`report`], the checks of `hooke report` written as a page with
+//!   plots (plotters, serde_json).
 //! * `clap`: command-line parsing for the option types ([`draw::Style`],
 //!   [`export::FolderFormat`]), for applications with their own command line.
 
@@ -45,6 +47,8 @@ pub mod interrupt;
 pub mod memory;
 pub mod output;
 pub mod progress;
+#[cfg(feature = "report")]
+pub mod report;
 mod sink;
 pub mod source;
 pub mod stills;

@@ -10,13 +10,18 @@ use hooke_scene::{Overrides, Scene};
 /// most telling at impact, squashed against the ground.
 const STILL_AT: [(&str, f64); 1] = [("jello-cube", 0.45)];
 
+/// The steps from the start of built-in scene `name` to the moment of its still.
+pub fn still_steps(name: &str, scene: &Scene) -> u64 {
+    match STILL_AT.iter().find(|(n, _)| *n == name) {
+        Some((_, t)) => crate::driver::steps_for(scene, *t),
+        None => scene.steps,
+    }
+}
+
 /// Builds built-in scene `name` and runs it to the moment of its still.
 pub fn still_scene(name: &str) -> Result<Scene> {
     let mut scene = source::build(name, &Overrides::default())?;
-    let steps = match STILL_AT.iter().find(|(n, _)| *n == name) {
-        Some((_, t)) => crate::driver::steps_for(&scene, *t),
-        None => scene.steps,
-    };
+    let steps = still_steps(name, &scene);
     scene.steps = steps;
     crate::driver::advance(&mut scene, steps)?;
     Ok(scene)

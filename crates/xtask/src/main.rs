@@ -19,8 +19,9 @@ struct Requirement {
 }
 
 /// What the viewer test (`crates/hooke-cli/tests/viewer.rs`) needs: a virtual X server, a
-/// key sender, and the X libraries the viewer loads at run time.
-const REQUIREMENTS: [Requirement; 4] = [
+/// key sender, and the X libraries the viewer loads at run time; and the browser the report
+/// test (`crates/hooke-cli/tests/report.rs`) renders the report's page in.
+const REQUIREMENTS: [Requirement; 5] = [
     Requirement {
         needs: "Xvfb",
         package: "xvfb",
@@ -36,6 +37,10 @@ const REQUIREMENTS: [Requirement; 4] = [
     Requirement {
         needs: "/usr/lib/x86_64-linux-gnu/libXcursor.so.1",
         package: "libxcursor1",
+    },
+    Requirement {
+        needs: "chromium",
+        package: "chromium",
     },
 ];
 
@@ -85,16 +90,18 @@ fn setup() -> Result<(), String> {
     }
     if !present("apt-get") {
         return Err(format!(
-            "the viewer test needs the packages {} and this machine has no apt-get: install \
-             them with its package manager, or set HOOKE_SKIP_VIEWER=1 to skip that one test",
+            "the viewer and report tests need the packages {} and this machine has no \
+             apt-get: install them with its package manager, or set HOOKE_SKIP_VIEWER=1 and \
+             HOOKE_SKIP_BROWSER=1 to skip those tests",
             missing.join(" ")
         ));
     }
     eprintln!(
-        "xtask: installing {} (Debian packages the viewer test needs)",
+        "xtask: installing {} (Debian packages the viewer and report tests need)",
         missing.join(" ")
     );
-    apt_install(&missing).map_err(|e| format!("{e}; or set HOOKE_SKIP_VIEWER=1"))
+    apt_install(&missing)
+        .map_err(|e| format!("{e}; or set HOOKE_SKIP_VIEWER=1 and HOOKE_SKIP_BROWSER=1"))
 }
 
 /// Installs Debian `packages` with apt-get, through `sudo` when not root.

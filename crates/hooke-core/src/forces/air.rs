@@ -88,7 +88,7 @@ pub struct AeroSurface {
 /// corner takes a third.
 ///
 /// ```
-/// use hooke_core::{Vec3, air::triangle_force};
+/// use hooke_core::{Vec3, forces::air::triangle_force};
 /// // A unit right triangle in the x-z plane falling face-on at 2 m/s in still air.
 /// let x = [Vec3::zeros(), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0)];
 /// let v = [Vec3::new(0.0, -2.0, 0.0); 3];

@@ -1,0 +1,221 @@
+//! The built-in scenes as pictures and contacts: each still beside its golden image with
+//! the pixels that differ, and on every frame up to the still the cloth's crossings (none
+//! allowed) and its smallest gap to a collider.
+
+use super::crossings::{self, Tri};
+use crate::Result;
+use crate::image_out::View;
+use crate::stills::{still_steps, still_view};
+use hooke_core::Vec3;
+use hooke_core::contact::proximity::point_triangle;
+use hooke_scene::{Overrides, Scene};
+use image::{Rgba, RgbaImage};
+use serde::Serialize;
+
+/// A channel difference (of 255) still counted as equal, and the share of pixels that may
+/// differ by more: the validation suite's own tolerance for its goldens.
+pub(crate) const CHANNEL_TOLERANCE: u8 = 4;
+pub(crate) const MISMATCH_FRACTION: f64 = 0.005;
+
+/// The golden stills of `golden/`, built into the binary so the report needs no checkout.
+const GOLDEN: [(&str, &[u8]); 7] = [
+    (
+        "single-spring",
+        include_bytes!("../../../../golden/single-spring.png"),
+    ),
+    ("chain", include_bytes!("../../../../golden/chain.png")),
+    (
+        "jello-cube",
+        include_bytes!("../../../../golden/jello-cube.png"),
+    ),
+    (
+        "hanging-cloth",
+        include_bytes!("../../../../golden/hanging-cloth.png"),
+    ),
+    (
+        "cloth-table",
+        include_bytes!("../../../../golden/cloth-table.png"),
+    ),
+    (
+        "cloth-pile",
+        include_bytes!("../../../../golden/cloth-pile.png"),
+    ),
+    ("flag", include_bytes!("../../../../golden/flag.png")),
+];
+
+/// Scenes quick enough for `--quick`.
+const QUICK: [&str; 3] = ["single-spring", "chain", "jello-cube"];
+
+/// One scene's still and contacts.
+#[derive(Serialize)]
+pub(crate) struct SceneCheck {
+    pub(crate) name: String,
+    /// The still's simulated time, s.
+    pub(crate) time: f64,
+    /// Pixels differing from the golden by more than the tolerance, and the share allowed.
+    pub(crate) differing_pixels: usize,
+    pub(crate) pixels: usize,
+    /// Frames checked for contacts.
+    pub(crate) frames: u64,
+    /// Cloth–collider and cloth–cloth crossing pairs, summed over the frames.
+    pub(crate) collider_crossings: usize,
+    pub(crate) cloth_crossings: usize,
+    /// The smallest distance from a surface particle to a collider's surface over the
+    /// frames, m (`None`: no surface or no collider).
+    pub(crate) min_gap: Option<f64>,
+    /// Files beside the page.
+    pub(crate) still: String,
+    pub(crate) golden: String,
+    pub(crate) diff: String,
+}
+
+/// The cloth's triangles now, with their corners.
+fn cloth(scene: &Scene) -> Vec<(Tri, [u32; 3])> {
+    let x = &scene.simulation.particles().x;
+    scene
+        .bodies
+        .iter()
+        .flat_map(|b| b.triangles.iter())
+        .map(|t| (t.map(|i| x[i as usize]), *t))
+        .collect()
+}
+
+/// The smallest distance from a surface particle to a collider triangle near it.
+fn min_gap(scene: &Scene, colliders: &[Tri]) -> Option<f64> {
+    let x = &scene.simulation.particles().x;
+    let mut best: Option<f64> = None;
+    let reach = 0.05;
+    for body in &scene.bodies {
+        if body.triangles.is_empty() {
+            continue;
+        }
+        for p in &x[body.range.clone()] {
+            for t in colliders {
+                let lo = t[0].inf(&t[1]).inf(&t[2]).add_scalar(-reach);
+                let hi = t[0].sup(&t[1]).sup(&t[2]).add_scalar(reach);
+                if (0..3).any(|k| p[k] < lo[k] || p[k] > hi[k]) {
+                    continue;
+                }
+                let w = point_triangle(p, &t[0], &t[1], &t[2]);
+                let q: Vec3 = t[0] * w[0] + t[1] * w[1] + t[2] * w[2];
+                let d = (p - q).norm();
+                best = Some(best.map_or(d, |b| b.min(d)));
+            }
+        }
+    }
+    best
+}
+
+/// Pixels of `actual` that differ from `golden` by more than the tolerance, and a picture
+/// of them: red over the golden dimmed.
+fn compare(golden: &RgbaImage, actual: &RgbaImage) -> (usize, RgbaImage) {
+    let mut diff = RgbaImage::new(golden.width(), golden.height());
+    let mut bad = 0;
+    for (x, y, g) in golden.enumerate_pixels() {
+        let a = actual.get_pixel(x, y);
+        let off =
+            g.0.iter()
+                .zip(a.0)
+                .any(|(g, a)| g.abs_diff(a) > CHANNEL_TOLERANCE);
+        let dim = |c: u8| (c as u16 * 2 / 5 + 150) as u8;
+        diff.put_pixel(
+            x,
+            y,
+            if off {
+                bad += 1;
+                Rgba([230, 20, 20, 255])
+            } else {
+                Rgba([dim(g[0]), dim(g[1]), dim(g[2]), 255])
+            },
+        );
+    }
+    (bad, diff)
+}
+
+/// Runs built-in `name` to its still, checking contacts on every frame, and compares the
+/// still with its golden; the images go to `dir`.
+fn check(name: &str, golden: &[u8], dir: &std::path::Path) -> Result<SceneCheck> {
+    let mut scene = crate::source::build(name, &Overrides::default())?;
+    let steps = still_steps(name, &scene);
+    let colliders: Vec<Tri> = crate::export::collider_triangles(&scene)
+        .into_iter()
+        .flat_map(|(_, t)| t)
+        .collect();
+    let surfaces = scene.bodies.iter().any(|b| !b.triangles.is_empty());
+    let (mut frames, mut against, mut among, mut gap) = (0, 0, 0, None::<f64>);
+    let mut look = |scene: &Scene| {
+        frames += 1;
+        if surfaces {
+            let (a, b) = crossings::count(&cloth(scene), &colliders);
+            against += a;
+            among += b;
+            if let Some(g) = min_gap(scene, &colliders) {
+                gap = Some(gap.map_or(g, |m| m.min(g)));
+            }
+        }
+    };
+    look(&scene);
+    let every = scene.every;
+    let mut done = 0;
+    while done < steps {
+        let n = every.min(steps - done);
+        crate::driver::advance(&mut scene, n)?;
+        done += n;
+        look(&scene);
+    }
+    let view = still_view(
+        name,
+        &View {
+            size: (320, 240),
+            ..View::default()
+        },
+    );
+    let actual = view.pixels(&scene, &view.camera(&scene));
+    let golden = image::load_from_memory(golden)?.to_rgba8();
+    let (bad, diff) = if golden.dimensions() == actual.dimensions() {
+        compare(&golden, &actual)
+    } else {
+        (actual.len() / 4, actual.clone())
+    };
+    let file = |kind: &str| format!("scene-{name}-{kind}.png");
+    crate::image_out::write_png(&dir.join(file("still")), &actual)?;
+    crate::image_out::write_png(&dir.join(file("golden")), &golden)?;
+    crate::image_out::write_png(&dir.join(file("diff")), &diff)?;
+    Ok(SceneCheck {
+        name: name.to_string(),
+        time: scene.simulation.time(),
+        differing_pixels: bad,
+        pixels: (actual.width() * actual.height()) as usize,
+        frames,
+        collider_crossings: against,
+        cloth_crossings: among,
+        min_gap: gap,
+        still: file("still"),
+        golden: file("golden"),
+        diff: file("diff"),
+    })
+}
+
+/// The scenes checked: all seven, or the quick ones.
+pub(crate) fn names(quick: bool) -> Vec<&'static str> {
+    GOLDEN
+        .iter()
+        .map(|(n, _)| *n)
+        .filter(|n| !quick || QUICK.contains(n))
+        .collect()
+}
+
+/// Every scene of [`names`], `tick` after each.
+pub(crate) fn checks(
+    quick: bool,
+    dir: &std::path::Path,
+    tick: &mut dyn FnMut(),
+) -> Result<Vec<SceneCheck>> {
+    let mut out = Vec::new();
+    for name in names(quick) {
+        let golden = GOLDEN.iter().find(|(n, _)| *n == name).unwrap().1;
+        out.push(check(name, golden, dir)?);
+        tick();
+    }
+    Ok(out)
+}
