@@ -3,77 +3,11 @@
 //! cloth in a side wind is displaced downwind, the reversed wind giving the mirror image.
 
 use crate::common::root;
-use hooke_core::{
-    AeroSurface, Air, Integrator, Model, Particles, Simulation, Spring, SpringKind, Vec3,
-};
+use hooke::report::{RHO, falling_sheet as sheet};
+use hooke_core::{Integrator, Simulation, Vec3};
 use hooke_scene::spec::{AirSpec, Finite, Positive};
 
-const RHO: f64 = 1.225;
 const G: f64 = 9.81;
-
-/// A square sheet of `n × n` particles and `side` metres, of `mass` kg in all, centred at
-/// `centre` and spanned by the unit vectors `a` and `b`; each particle weighs its share of
-/// the triangles' area (lumped masses), so air and gravity accelerate every particle alike
-/// and the sheet stays flat. Stiff structural springs hold its shape.
-fn sheet(n: usize, side: f64, mass: f64, centre: Vec3, (a, b): (Vec3, Vec3)) -> (Particles, Model) {
-    let h = side / (n - 1) as f64;
-    let id = |r: usize, c: usize| (r * n + c) as u32;
-    let mut triangles = Vec::new();
-    for r in 0..n - 1 {
-        for c in 0..n - 1 {
-            triangles.push([id(r, c), id(r + 1, c), id(r + 1, c + 1)]);
-            triangles.push([id(r, c), id(r + 1, c + 1), id(r, c + 1)]);
-        }
-    }
-    // Each triangle has area h²/2, a third of it to each corner.
-    let mut share = vec![0.0; n * n];
-    for t in &triangles {
-        for &p in t {
-            share[p as usize] += h * h / 6.0;
-        }
-    }
-    let mut particles = Particles::default();
-    for r in 0..n {
-        for c in 0..n {
-            let offset = a * (c as f64 * h - 0.5 * side) + b * (r as f64 * h - 0.5 * side);
-            let m = mass * share[r * n + c] / (side * side);
-            particles.push(centre + offset, Vec3::zeros(), m);
-        }
-    }
-    let mut springs = Vec::new();
-    for r in 0..n {
-        for c in 0..n {
-            for (dr, dc) in [(0, 1), (1, 0)] {
-                if r + dr < n && c + dc < n {
-                    springs.push(Spring {
-                        i: id(r, c),
-                        j: id(r + dr, c + dc),
-                        rest: h,
-                        ks: 500.0,
-                        kd: 0.05,
-                        kind: SpringKind::Structural,
-                    });
-                }
-            }
-        }
-    }
-    let model = Model {
-        springs,
-        gravity: Vec3::new(0.0, -G, 0.0),
-        air: Some(Air {
-            density: RHO,
-            wind: Vec3::zeros(),
-            gust: None,
-        }),
-        aero: vec![AeroSurface {
-            triangles,
-            drag: 1.0,
-            lift: 0.0,
-        }],
-        ..Model::default()
-    };
-    (particles, model)
-}
 
 fn mean(v: &[Vec3]) -> Vec3 {
     v.iter().sum::<Vec3>() / v.len() as f64

@@ -176,6 +176,15 @@ pub fn create(target: &Target, scene: &Scene) -> Result<Box<dyn crate::Sink + Se
     })
 }
 
+/// What a folder export wrote, for the run's report: `N KIND frames in DIR`.
+fn frames_written(kind: &str, frames: u64, dir: &Path) -> String {
+    format!(
+        "{frames} {kind} frame{} in {}",
+        if frames == 1 { "" } else { "s" },
+        dir.display()
+    )
+}
+
 /// Prepares `dir` for a folder export's `frame-NNNNN.ext` files (see
 /// [`crate::output::prepare_frame_folder`]), saying how many frames of an earlier run it
 /// removed; returns the folder's lock.

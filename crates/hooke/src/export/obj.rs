@@ -133,11 +133,6 @@ impl crate::Sink for ObjExport {
 
     /// What was written, for the run's report.
     fn finish(self: Box<Self>) -> Result<String> {
-        Ok(format!(
-            "{} OBJ frame{} in {}",
-            self.frames,
-            if self.frames == 1 { "" } else { "s" },
-            self.dir.display()
-        ))
+        Ok(super::frames_written("OBJ", self.frames, &self.dir))
     }
 }

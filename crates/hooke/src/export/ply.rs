@@ -189,11 +189,6 @@ impl crate::Sink for PlyExport {
 
     /// What was written, for the run's report.
     fn finish(self: Box<Self>) -> Result<String> {
-        Ok(format!(
-            "{} PLY frame{} in {}",
-            self.frames,
-            if self.frames == 1 { "" } else { "s" },
-            self.dir.display()
-        ))
+        Ok(super::frames_written("PLY", self.frames, &self.dir))
     }
 }

@@ -13,6 +13,8 @@ mod energy;
 mod machine;
 mod page;
 mod physics;
+
+pub use physics::{RHO, falling_sheet};
 mod plots;
 mod scenes;
 mod worlds;

@@ -27,6 +27,35 @@ fn drawing<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> cr
     }
 }
 
+/// A chart on `root` with its caption and room for the axes' labels.
+fn builder<'a, 'b>(
+    root: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
+    caption: impl AsRef<str>,
+    y_labels: u32,
+) -> ChartBuilder<'a, 'b, SVGBackend<'b>> {
+    let mut b = ChartBuilder::on(root);
+    b.caption(caption, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(y_labels);
+    b
+}
+
+/// The series' legend at `at`, on a light box.
+fn legend<'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, SVGBackend<'a>, CT>,
+    at: SeriesLabelPosition,
+) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .position(at)
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 16))
+        .draw()
+        .map_err(drawing)
+}
+
 /// The range `[lo, hi]` of positive values, widened to whole decades.
 fn decades(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
@@ -50,14 +79,7 @@ pub(crate) fn convergence(sweeps: &[Sweep]) -> Result<String> {
         root.fill(&WHITE).map_err(drawing)?;
         let x = decades(sweeps.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
         let y = decades(sweeps.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                "single-spring: largest height error over 2 s",
-                ("sans-serif", 20),
-            )
-            .margin(12)
-            .x_label_area_size(44)
-            .y_label_area_size(70)
+        let mut chart = builder(&root, "single-spring: largest height error over 2 s", 70)
             .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
             .map_err(drawing)?;
         chart
@@ -92,14 +114,7 @@ pub(crate) fn convergence(sweeps: &[Sweep]) -> Result<String> {
                 .draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))
                 .map_err(drawing)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 16))
-            .draw()
-            .map_err(drawing)?;
+        legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         root.present().map_err(drawing)?;
     }
     Ok(svg)
@@ -116,11 +131,7 @@ pub(crate) fn stability(sweeps: &[Sweep]) -> Result<String> {
             .flat_map(|s| [s.theory_limit, s.measured_limit, s.check_limit]);
         let y = decades(values);
         let names: Vec<String> = sweeps.iter().map(|s| s.integrator.clone()).collect();
-        let mut chart = ChartBuilder::on(&root)
-            .caption("single-spring: largest stable step", ("sans-serif", 20))
-            .margin(12)
-            .x_label_area_size(44)
-            .y_label_area_size(70)
+        let mut chart = builder(&root, "single-spring: largest stable step", 70)
             .build_cartesian_2d(
                 -0.5f64..sweeps.len() as f64 - 0.5,
                 (y.0..y.1 * 10.0).log_scale(),
@@ -178,14 +189,7 @@ pub(crate) fn stability(sweeps: &[Sweep]) -> Result<String> {
                 .label(label)
                 .legend(move |(x, y)| Circle::new((x + 8, y), 5, colour.filled()));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 16))
-            .draw()
-            .map_err(drawing)?;
+        legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
         root.present().map_err(drawing)?;
     }
     Ok(svg)
@@ -225,11 +229,7 @@ pub(crate) fn energy(scene: &str, runs: &[&EnergyRun], own: &str) -> Result<Stri
         let (lo, hi) = finite.fold((f64::MAX, f64::MIN), |(lo, hi), v| (lo.min(v), hi.max(v)));
         let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };
         let pad = ((hi - lo) * 0.1).max(1e-9 * hi.abs().max(1.0));
-        let mut chart = ChartBuilder::on(&root)
-            .caption(format!("{scene}: total energy"), ("sans-serif", 20))
-            .margin(12)
-            .x_label_area_size(44)
-            .y_label_area_size(80)
+        let mut chart = builder(&root, format!("{scene}: total energy"), 80)
             .build_cartesian_2d(0.0..t_end, (lo - pad)..(hi + pad))
             .map_err(drawing)?;
         chart
@@ -271,14 +271,7 @@ pub(crate) fn energy(scene: &str, runs: &[&EnergyRun], own: &str) -> Result<Stri
                 chart.draw_series(dashes).map_err(drawing)?;
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 16))
-            .draw()
-            .map_err(drawing)?;
+        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(drawing)?;
     }
     Ok(svg)
