@@ -70,6 +70,7 @@ const ENERGY_TOLERANCE: f64 = 0.01;
 /// Runs every check and writes the page into `dir` (created if missing).
 pub fn write(dir: &Path, options: &Options) -> Result<Outcome> {
     crate::output::check_output_folder(dir, "report")?;
+    refuse_foreign_folder(dir)?;
     std::fs::create_dir_all(dir).map_err(|e| {
         crate::Error::from(e).context(format!(
             "report {}: cannot create the folder",
@@ -128,6 +129,33 @@ pub fn write(dir: &Path, options: &Options) -> Result<Outcome> {
     Ok(Outcome {
         page: dir.join("index.html"),
         failures: report.failures,
+    })
+}
+
+/// A report replaces its own files: a folder that holds files but no earlier report is the
+/// user's, and is refused rather than written into.
+fn refuse_foreign_folder(dir: &Path) -> Result<()> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(());
+    };
+    let names: Vec<String> = entries
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| !n.starts_with(".hooke-"))
+        .collect();
+    if names.is_empty() || names.iter().any(|n| n == "report.json") {
+        return Ok(());
+    }
+    let mut shown: Vec<&str> = names.iter().map(String::as_str).take(3).collect();
+    shown.sort_unstable();
+    Err(crate::Error::Output {
+        message: format!(
+            "report {}: the folder holds other files ({}{}) and no earlier report; choose a \
+             new or empty folder, or an earlier report's",
+            dir.display(),
+            shown.join(", "),
+            if names.len() > 3 { ", …" } else { "" }
+        ),
     })
 }
 
@@ -268,6 +296,25 @@ mod tests {
             },
             seconds: Vec::new(),
         }
+    }
+
+    #[test]
+    fn a_folder_of_other_files_is_refused_and_an_earlier_report_is_not() {
+        let dir = std::env::temp_dir().join(format!("hooke-report-foreign-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        assert!(refuse_foreign_folder(&dir).is_ok(), "an empty folder");
+        std::fs::write(dir.join("thesis.tex"), "mine").unwrap();
+        let e = refuse_foreign_folder(&dir).unwrap_err().to_string();
+        assert!(
+            e.contains("thesis.tex") && e.contains("no earlier report"),
+            "{e}"
+        );
+        std::fs::write(dir.join("report.json"), "{}").unwrap();
+        assert!(
+            refuse_foreign_folder(&dir).is_ok(),
+            "an earlier report's folder"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
