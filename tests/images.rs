@@ -1,8 +1,9 @@
 //! Image goldens: a still of each built-in scene and of one jello world, rendered and
 //! compared with `golden/<name>.png` as decoded pixels.
 //!
-//! **Tolerance.** A pixel matches when each channel is within [`CHANNEL_TOLERANCE`] levels;
-//! an image matches when at most [`MISMATCH_FRACTION`] of its pixels do not. Other platforms'
+//! **Tolerance** (`hooke::report::pixels`, which `hooke report` uses too). A pixel matches
+//! when each channel is within [`CHANNEL_TOLERANCE`] levels; an image matches when at most
+//! `MISMATCH_FRACTION` of its pixels do not. Other platforms'
 //! libm (sin/cos place the rotated jelly) and the sticking decisions of `cloth-table` (a
 //! discontinuous response that amplifies round-off) may move a few edge pixels; a change to
 //! the physics or the renderer moves whole surfaces, thousands of pixels.
@@ -15,15 +16,11 @@
 
 use crate::common::root;
 use hooke::image_out::View;
+use hooke::report::pixels::{CHANNEL_TOLERANCE, allowed, compare};
 use hooke::stills::{still_scene, still_view};
 use hooke_scene::Overrides;
 use image::{Rgba, RgbaImage};
 use std::path::{Path, PathBuf};
-
-/// Channel difference (of 255) still counted as equal.
-const CHANNEL_TOLERANCE: u8 = 4;
-/// Fraction of pixels allowed to differ by more than [`CHANNEL_TOLERANCE`].
-const MISMATCH_FRACTION: f64 = 0.005;
 
 /// Golden stills are small: enough to recognise each scene, cheap to store and compare.
 fn view() -> View {
@@ -54,26 +51,6 @@ fn update_mode() -> Update {
 fn save(path: &Path, image: &RgbaImage) {
     std::fs::create_dir_all(path.parent().unwrap()).unwrap();
     image.save(path).unwrap();
-}
-
-/// Pixels differing by more than the tolerance, and a picture of where.
-fn compare(golden: &RgbaImage, actual: &RgbaImage) -> (usize, RgbaImage) {
-    let mut diff = RgbaImage::new(golden.width(), golden.height());
-    let mut bad = 0;
-    for ((g, a), d) in golden.pixels().zip(actual.pixels()).zip(diff.pixels_mut()) {
-        let differs = g.0[..3]
-            .iter()
-            .zip(&a.0[..3])
-            .any(|(g, a)| g.abs_diff(*a) > CHANNEL_TOLERANCE);
-        *d = if differs {
-            bad += 1;
-            Rgba([255, 0, 0, 255])
-        } else {
-            let grey = (g.0[0] as u16 + g.0[1] as u16 + g.0[2] as u16) / 6 + 100;
-            Rgba([grey as u8, grey as u8, grey as u8, 255])
-        };
-    }
-    (bad, diff)
 }
 
 /// Compares `actual` with `golden/<name>.png`, returning a failure message.
@@ -115,7 +92,7 @@ fn check(name: &str, actual: &RgbaImage) -> Option<String> {
         ));
     }
     let (bad, diff) = compare(&golden, actual);
-    let allowed = (MISMATCH_FRACTION * (golden.width() * golden.height()) as f64) as usize;
+    let allowed = allowed((golden.width() * golden.height()) as usize);
     if bad <= allowed {
         let _ = std::fs::remove_file(&new_path);
         return None;

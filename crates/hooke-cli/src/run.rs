@@ -97,8 +97,7 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
     let result = record(&mut scene, sinks, |frame, scene| {
         if args.summary {
             let sim = &scene.simulation;
-            // docs/physics.md §6: the time of frame f is (f K) dt computed as one product.
-            let time = (frame * every) as f64 * dt;
+            let time = hooke::driver::frame_time(scene, frame);
             let s = Summary::of(sim.model(), sim.particles());
             let v = |v: hooke_core::Vec3| format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z);
             println!(

@@ -35,6 +35,12 @@ pub fn steps_for(scene: &Scene, seconds: f64) -> u64 {
     (seconds / scene.simulation.dt()).round() as u64
 }
 
+/// The simulated time of frame `frame` of `scene`, seconds: `(f K) dt` computed as one
+/// product (docs/physics.md §6), so every output names a frame's time with the same bits.
+pub fn frame_time(scene: &Scene, frame: u64) -> f64 {
+    (frame * scene.every) as f64 * scene.simulation.dt()
+}
+
 /// The most steps a still at a chosen time may take: beyond this it is years of computing
 /// away.
 pub const MAX_STILL_STEPS: f64 = 1e12;

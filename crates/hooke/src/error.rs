@@ -239,16 +239,11 @@ impl From<SceneError> for Error {
             },
             SceneError::Syntax { path, message } => Location {
                 file: Some(path.clone()),
-                line: Location::from_text(&format!("x:{message}"))
-                    .line
-                    .or_else(|| {
-                        // toml's messages read "line N, column M".
-                        message
-                            .split("line ")
-                            .nth(1)
-                            .and_then(|rest| rest.split(|c: char| !c.is_ascii_digit()).next())
-                            .and_then(|n| n.parse().ok())
-                    }),
+                // The reader's messages start "line N, column M: ".
+                line: message
+                    .strip_prefix("line ")
+                    .and_then(|rest| rest.split(|c: char| !c.is_ascii_digit()).next())
+                    .and_then(|n| n.parse().ok()),
                 key: None,
             },
         };
@@ -353,6 +348,19 @@ mod tests {
         let e = Error::input("expected a number").context("scene 'x'");
         assert_eq!(e.to_string(), "scene 'x': expected a number");
         assert!(matches!(e, Error::Input { .. }));
+    }
+
+    #[test]
+    fn a_scene_syntax_error_keeps_its_file_and_line() {
+        let text = "name = \"bad\"\n[simulation]\ndt = \"fast\"\n";
+        let e: Error = hooke_scene::parse_scene(text, "bad.toml")
+            .unwrap_err()
+            .into();
+        let Error::Input { location, .. } = e else {
+            panic!("not an input error")
+        };
+        assert_eq!(location.file, Some(PathBuf::from("bad.toml")));
+        assert_eq!(location.line, Some(3));
     }
 
     #[test]

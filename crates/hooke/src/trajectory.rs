@@ -51,8 +51,7 @@ impl TrajectoryWriter {
 
 impl crate::Sink for TrajectoryWriter {
     fn frame(&mut self, frame: u64, scene: &hooke_scene::Scene) -> Result<()> {
-        // docs/physics.md §6: the time of frame f is (f K) dt computed as one product.
-        let time = (frame * scene.every) as f64 * scene.simulation.dt();
+        let time = crate::driver::frame_time(scene, frame);
         self.append(frame, time, scene.simulation.particles())
     }
 

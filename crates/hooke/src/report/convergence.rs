@@ -56,6 +56,28 @@ pub(crate) struct Sweep {
     pub(crate) check_limit: f64,
 }
 
+/// How far a fitted order may lie from the scheme's.
+pub(crate) const SLOPE_TOLERANCE: f64 = 0.1;
+/// How far the measured stability limit may lie from theory's, as a share.
+pub(crate) const STABILITY_TOLERANCE: f64 = 0.05;
+
+impl Sweep {
+    /// Whether the fitted order is the scheme's (NaN is not).
+    pub(crate) fn order_agrees(&self) -> bool {
+        (self.slope - self.expected).abs() <= SLOPE_TOLERANCE
+    }
+
+    /// Whether the step it went unstable at is theory's (for a scheme theory says never
+    /// goes unstable: it never did).
+    pub(crate) fn stability_agrees(&self) -> bool {
+        if self.theory_limit.is_finite() {
+            (self.measured_limit / self.theory_limit - 1.0).abs() <= STABILITY_TOLERANCE
+        } else {
+            self.measured_limit.is_infinite()
+        }
+    }
+}
+
 /// The steps of each scheme's sweep: small enough to be in its asymptotic range, large
 /// enough to stay above round-off.
 fn steps_for(i: Integrator, quick: bool) -> Vec<f64> {

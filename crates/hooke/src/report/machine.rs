@@ -16,6 +16,13 @@ pub(crate) struct Hashes {
     pub(crate) many_threads: String,
 }
 
+impl Hashes {
+    /// Whether one thread and many gave the same bits.
+    pub(crate) fn agree(&self) -> bool {
+        self.one_thread == self.many_threads
+    }
+}
+
 /// The workload's rate.
 #[derive(Serialize)]
 pub(crate) struct Speed {

@@ -13,6 +13,7 @@ mod energy;
 mod machine;
 mod page;
 mod physics;
+pub mod pixels;
 
 pub use physics::{RHO, falling_sheet};
 mod plots;
@@ -60,9 +61,6 @@ struct Report {
     seconds: Vec<(&'static str, f64)>,
 }
 
-/// Tolerances of the checks, stated once.
-const SLOPE_TOLERANCE: f64 = 0.1;
-const STABILITY_TOLERANCE: f64 = 0.05;
 /// The energy a closed scene loses beyond what damping took, as a share of what it took,
 /// with midpoint and RK4 (whose own energy error at the scene's step is far smaller).
 const ENERGY_TOLERANCE: f64 = 0.01;
@@ -168,18 +166,16 @@ fn within(x: f64, tolerance: f64) -> bool {
 fn failures(r: &Report) -> Vec<String> {
     let mut out = Vec::new();
     for s in &r.convergence {
-        if !within(s.slope - s.expected, SLOPE_TOLERANCE) {
+        if !s.order_agrees() {
             out.push(format!(
-                "convergence: {} fits order {:.2} on the single spring, expected {} ± {SLOPE_TOLERANCE}",
-                s.integrator, s.slope, s.expected
+                "convergence: {} fits order {:.2} on the single spring, expected {} ± {}",
+                s.integrator,
+                s.slope,
+                s.expected,
+                convergence::SLOPE_TOLERANCE
             ));
         }
-        let agrees = if s.theory_limit.is_finite() {
-            (s.measured_limit / s.theory_limit - 1.0).abs() <= STABILITY_TOLERANCE
-        } else {
-            s.measured_limit.is_infinite()
-        };
-        if !agrees {
+        if !s.stability_agrees() {
             out.push(format!(
                 "stability: {} went unstable at dt = {:.4e} s, theory says {:.4e} s",
                 s.integrator, s.measured_limit, s.theory_limit
@@ -221,25 +217,24 @@ fn failures(r: &Report) -> Vec<String> {
         }
     }
     for s in &r.scenes {
-        if s.differing_pixels as f64 > scenes::MISMATCH_FRACTION * s.pixels as f64 {
+        if !s.matches_golden() {
             out.push(format!(
                 "scenes: {}'s still differs from its golden image in {} of {} pixels (at most {:.1} % may)",
                 s.name,
                 s.differing_pixels,
                 s.pixels,
-                100.0 * scenes::MISMATCH_FRACTION
+                100.0 * pixels::MISMATCH_FRACTION
             ));
         }
-        if s.collider_crossings + s.cloth_crossings > 0 {
+        if s.crossings() > 0 {
             out.push(format!(
                 "contacts: {} has {} cloth–collider and {} cloth–cloth crossings over {} frames",
                 s.name, s.collider_crossings, s.cloth_crossings, s.frames
             ));
         }
     }
-    for w in r.worlds.iter().filter(|w| w.own) {
+    for w in r.worlds.iter().filter(|w| w.own && !w.matches_reference()) {
         match w.max_difference {
-            Some(d) if d <= worlds::ROUNDING => {}
             Some(d) => out.push(format!(
                 "worlds: {} with {} differs from its reference by {d:.3e} m",
                 w.world, w.integrator
@@ -251,7 +246,7 @@ fn failures(r: &Report) -> Vec<String> {
         }
     }
     for h in &r.determinism {
-        if h.one_thread != h.many_threads {
+        if !h.agree() {
             out.push(format!(
                 "determinism: {} hashes {} on 1 thread and {} on {}",
                 h.run, h.one_thread, h.many_threads, h.threads

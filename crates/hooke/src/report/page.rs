@@ -156,23 +156,17 @@ fn convergence(h: &mut String, r: &Report) -> Result<()> {
          <th></th><th>unstable from (measured, s)</th><th>theory (s)</th><th>hooke check (s)</th><th></th></tr>"
     )?;
     for s in &r.convergence {
-        let slope_ok = (s.slope - s.expected).abs() <= super::SLOPE_TOLERANCE;
-        let stable_ok = if s.theory_limit.is_finite() {
-            (s.measured_limit / s.theory_limit - 1.0).abs() <= super::STABILITY_TOLERANCE
-        } else {
-            s.measured_limit.is_infinite()
-        };
         writeln!(
             h,
             "<tr><td>{}</td><td>{:.3}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             s.integrator,
             s.slope,
             s.expected,
-            verdict(slope_ok),
+            verdict(s.order_agrees()),
             num(s.measured_limit),
             num(s.theory_limit),
             num(s.check_limit),
-            verdict(stable_ok)
+            verdict(s.stability_agrees())
         )?;
     }
     writeln!(h, "</table></div>")?;
@@ -255,8 +249,8 @@ fn scenes(h: &mut String, r: &Report) -> Result<()> {
          image and the pixels that differ by more than {} levels (red; at most {:.1} % may). On every \
          frame up to the still: crossings between the cloth and the colliders and within the cloth \
          (none allowed), and the cloth's smallest gap to a collider.</p>",
-        super::scenes::CHANNEL_TOLERANCE,
-        100.0 * super::scenes::MISMATCH_FRACTION
+        super::pixels::CHANNEL_TOLERANCE,
+        100.0 * super::pixels::MISMATCH_FRACTION
     )?;
     writeln!(
         h,
@@ -264,9 +258,6 @@ fn scenes(h: &mut String, r: &Report) -> Result<()> {
          <th>frames</th><th>crossings</th><th>min gap (mm)</th><th></th></tr>"
     )?;
     for s in &r.scenes {
-        let pixels_ok =
-            s.differing_pixels as f64 <= super::scenes::MISMATCH_FRACTION * s.pixels as f64;
-        let crossings = s.collider_crossings + s.cloth_crossings;
         writeln!(
             h,
             "<tr><td>{}</td><td>{}</td><td>{} of {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
@@ -274,11 +265,11 @@ fn scenes(h: &mut String, r: &Report) -> Result<()> {
             num(s.time),
             s.differing_pixels,
             s.pixels,
-            verdict(pixels_ok),
+            verdict(s.matches_golden()),
             s.frames,
-            crossings,
+            s.crossings(),
             s.min_gap.map_or("—".into(), |g| format!("{:.2}", 1e3 * g)),
-            verdict(crossings == 0)
+            verdict(s.crossings() == 0)
         )?;
     }
     writeln!(h, "</table></div>")?;
@@ -327,10 +318,11 @@ fn worlds(h: &mut String, r: &Report) -> Result<()> {
                 Some(w) => {
                     let text = w.max_difference.map_or("diverged".into(), num);
                     if w.own {
-                        let ok = w
-                            .max_difference
-                            .is_some_and(|d| d <= super::worlds::ROUNDING);
-                        write!(h, "<td><b>{text}</b> {}</td>", verdict(ok))?;
+                        write!(
+                            h,
+                            "<td><b>{text}</b> {}</td>",
+                            verdict(w.matches_reference())
+                        )?;
                     } else {
                         write!(h, "<td>{text}</td>")?;
                     }
@@ -362,7 +354,7 @@ fn machine(h: &mut String, r: &Report) -> Result<()> {
             esc(&d.run),
             d.one_thread,
             d.many_threads,
-            verdict(d.one_thread == d.many_threads)
+            verdict(d.agree())
         )?;
     }
     let s = &r.speed;

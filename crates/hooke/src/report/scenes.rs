@@ -3,19 +3,14 @@
 //! allowed) and its smallest gap to a collider.
 
 use super::crossings::{self, Tri};
+use super::pixels::compare;
 use crate::Result;
 use crate::image_out::View;
 use crate::stills::{still_steps, still_view};
 use hooke_core::Vec3;
 use hooke_core::contact::proximity::point_triangle;
 use hooke_scene::{Overrides, Scene};
-use image::{Rgba, RgbaImage};
 use serde::Serialize;
-
-/// A channel difference (of 255) still counted as equal, and the share of pixels that may
-/// differ by more: the validation suite's own tolerance for its goldens.
-pub(crate) const CHANNEL_TOLERANCE: u8 = 4;
-pub(crate) const MISMATCH_FRACTION: f64 = 0.005;
 
 /// The golden stills of `golden/`, built into the binary so the report needs no checkout.
 const GOLDEN: [(&str, &[u8]); 7] = [
@@ -52,7 +47,7 @@ pub(crate) struct SceneCheck {
     pub(crate) name: String,
     /// The still's simulated time, s.
     pub(crate) time: f64,
-    /// Pixels differing from the golden by more than the tolerance, and the share allowed.
+    /// Pixels differing from the golden by more than the tolerance, of all its pixels.
     pub(crate) differing_pixels: usize,
     pub(crate) pixels: usize,
     /// Frames checked for contacts.
@@ -80,22 +75,41 @@ fn cloth(scene: &Scene) -> Vec<(Tri, [u32; 3])> {
         .collect()
 }
 
+/// How near a collider triangle a particle must be for its distance to count, m.
+const GAP_REACH: f64 = 0.05;
+
+/// A collider triangle with its box grown by [`GAP_REACH`], computed once per scene.
+struct Near {
+    corners: Tri,
+    lo: Vec3,
+    hi: Vec3,
+}
+
+impl Near {
+    fn new(corners: &Tri) -> Self {
+        let t = corners;
+        Self {
+            corners: *t,
+            lo: t[0].inf(&t[1]).inf(&t[2]).add_scalar(-GAP_REACH),
+            hi: t[0].sup(&t[1]).sup(&t[2]).add_scalar(GAP_REACH),
+        }
+    }
+}
+
 /// The smallest distance from a surface particle to a collider triangle near it.
-fn min_gap(scene: &Scene, colliders: &[Tri]) -> Option<f64> {
+fn min_gap(scene: &Scene, colliders: &[Near]) -> Option<f64> {
     let x = &scene.simulation.particles().x;
     let mut best: Option<f64> = None;
-    let reach = 0.05;
     for body in &scene.bodies {
         if body.triangles.is_empty() {
             continue;
         }
         for p in &x[body.range.clone()] {
-            for t in colliders {
-                let lo = t[0].inf(&t[1]).inf(&t[2]).add_scalar(-reach);
-                let hi = t[0].sup(&t[1]).sup(&t[2]).add_scalar(reach);
-                if (0..3).any(|k| p[k] < lo[k] || p[k] > hi[k]) {
+            for near in colliders {
+                if (0..3).any(|k| p[k] < near.lo[k] || p[k] > near.hi[k]) {
                     continue;
                 }
+                let t = &near.corners;
                 let w = point_triangle(p, &t[0], &t[1], &t[2]);
                 let q: Vec3 = t[0] * w[0] + t[1] * w[1] + t[2] * w[2];
                 let d = (p - q).norm();
@@ -106,30 +120,16 @@ fn min_gap(scene: &Scene, colliders: &[Tri]) -> Option<f64> {
     best
 }
 
-/// Pixels of `actual` that differ from `golden` by more than the tolerance, and a picture
-/// of them: red over the golden dimmed.
-fn compare(golden: &RgbaImage, actual: &RgbaImage) -> (usize, RgbaImage) {
-    let mut diff = RgbaImage::new(golden.width(), golden.height());
-    let mut bad = 0;
-    for (x, y, g) in golden.enumerate_pixels() {
-        let a = actual.get_pixel(x, y);
-        let off =
-            g.0.iter()
-                .zip(a.0)
-                .any(|(g, a)| g.abs_diff(a) > CHANNEL_TOLERANCE);
-        let dim = |c: u8| (c as u16 * 2 / 5 + 150) as u8;
-        diff.put_pixel(
-            x,
-            y,
-            if off {
-                bad += 1;
-                Rgba([230, 20, 20, 255])
-            } else {
-                Rgba([dim(g[0]), dim(g[1]), dim(g[2]), 255])
-            },
-        );
+impl SceneCheck {
+    /// Whether the still matches its golden.
+    pub(crate) fn matches_golden(&self) -> bool {
+        self.differing_pixels <= super::pixels::allowed(self.pixels)
     }
-    (bad, diff)
+
+    /// Crossing pairs of all kinds, summed over the frames.
+    pub(crate) fn crossings(&self) -> usize {
+        self.collider_crossings + self.cloth_crossings
+    }
 }
 
 /// Runs built-in `name` to its still, checking contacts on every frame, and compares the
@@ -141,6 +141,7 @@ fn check(name: &str, golden: &[u8], dir: &std::path::Path) -> Result<SceneCheck>
         .into_iter()
         .flat_map(|(_, t)| t)
         .collect();
+    let near: Vec<Near> = colliders.iter().map(Near::new).collect();
     let surfaces = scene.bodies.iter().any(|b| !b.triangles.is_empty());
     let (mut frames, mut against, mut among, mut gap) = (0, 0, 0, None::<f64>);
     let mut look = |scene: &Scene| {
@@ -149,7 +150,7 @@ fn check(name: &str, golden: &[u8], dir: &std::path::Path) -> Result<SceneCheck>
             let (a, b) = crossings::count(&cloth(scene), &colliders);
             against += a;
             among += b;
-            if let Some(g) = min_gap(scene, &colliders) {
+            if let Some(g) = min_gap(scene, &near) {
                 gap = Some(gap.map_or(g, |m| m.min(g)));
             }
         }

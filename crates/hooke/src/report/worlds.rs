@@ -63,6 +63,13 @@ pub(crate) struct WorldRun {
     pub(crate) max_difference: Option<f64>,
 }
 
+impl WorldRun {
+    /// Whether the run stayed within the reference's rounding.
+    pub(crate) fn matches_reference(&self) -> bool {
+        self.max_difference.is_some_and(|d| d <= ROUNDING)
+    }
+}
+
 /// `(step, particle, position)` of a reference.
 fn reference(text: &str) -> Vec<(u64, usize, [f64; 3])> {
     let mut out = Vec::new();
