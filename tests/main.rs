@@ -15,5 +15,6 @@ mod layout;
 mod oscillator;
 mod roundtrip;
 mod scenes;
+mod starts;
 mod statics;
 mod worlds;

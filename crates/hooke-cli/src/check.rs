@@ -24,6 +24,11 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
         estimate.omega_max
     );
     println!(
+        "fastest damping rate γ_max ≈ {:.4e} 1/s (springs' kd, drag, penalty dc, air; \
+         an explicit step also needs dt γ_max within its real stability interval)",
+        estimate.damping_max
+    );
+    println!(
         "scene step: dt = {} s with {}",
         Num(sim.dt()),
         sim.integrator()

@@ -47,7 +47,8 @@ enum Command {
     },
     /// Run the checks that show the physics is right (convergence, closed forms, energy,
     /// goldens, contacts, worlds, determinism, speed) and write them as a page:
-    /// DIR/index.html with its plots, and every number in DIR/report.json.
+    /// DIR/index.html with its plots, and every number in DIR/report.json. Exit status: 0
+    /// every check passed, 1 a check failed, 2 the report could not run.
     Report {
         /// Output folder.
         dir: PathBuf,
@@ -215,6 +216,12 @@ fn quiet_on_closed_pipe() {
 fn main() -> ExitCode {
     quiet_on_closed_pipe();
     let cli = Cli::parse();
+    // `hooke report` tells a failed check (1) from a report that could not run (2), as
+    // pytest tells failed tests from a usage error; every other command fails with 1.
+    let could_not_run = match cli.command {
+        Command::Report { .. } => ExitCode::from(report::COULD_NOT_RUN),
+        _ => ExitCode::FAILURE,
+    };
     hooke::interrupt::install();
     hooke::progress::install(Box::new(hooke_cli::bars::Bars));
     // Everything but the window runs on a worker of the thread pool: the solver's parallel
@@ -243,7 +250,7 @@ fn main() -> ExitCode {
         }
         Err(e) => {
             eprintln!("error: {e:#}");
-            ExitCode::FAILURE
+            could_not_run
         }
     }
 }

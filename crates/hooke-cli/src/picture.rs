@@ -3,7 +3,7 @@
 use crate::RenderArgs;
 use anyhow::{Context, Result};
 use hooke::driver::{advance, drive, steps_to};
-use hooke::image_out::{GifWriter, View, write_png};
+use hooke::image_out::{GifWriter, View, write_png, write_png_named};
 use hooke::output::{check_output_file, check_output_folder};
 use hooke::source;
 use hooke::stills::{still_scene, still_view};
@@ -60,6 +60,11 @@ pub fn demo(out: &Path, view: &View) -> Result<ExitCode> {
         .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
     // Two demos writing one folder would mix their stills.
     let _held = hooke::output::lock::FolderLock::take(out, "--out")?;
+    // Every name the demo writes, checked before the first scene runs.
+    for (k, (name, _)) in BUILTINS.iter().enumerate() {
+        hooke::output::check_named(&out.join(still_name(k, name)), "--out")?;
+    }
+    hooke::output::check_named(&out.join(animation_name(ANIMATED.0)), "--out")?;
     let mut written: Vec<PathBuf> = Vec::new();
     for (k, (name, _)) in BUILTINS.iter().enumerate() {
         let started = Instant::now();
@@ -67,8 +72,8 @@ pub fn demo(out: &Path, view: &View) -> Result<ExitCode> {
         let simulated = started.elapsed();
         let view = still_view(name, view);
         let camera = view.camera(&scene);
-        let path = out.join(format!("{}-{name}.png", k + 1));
-        write_png(&path, &view.pixels(&scene, &camera))?;
+        let path = out.join(still_name(k, name));
+        write_png_named(&path, "--out", &view.pixels(&scene, &camera))?;
         eprintln!(
             "{name:<14} {} s simulated in {:.2} s, still rendered in {:.2} s -> {}",
             Num(scene.simulation.time()),
@@ -88,6 +93,16 @@ pub fn demo(out: &Path, view: &View) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The demo's still of built-in scene number `k`.
+fn still_name(k: usize, name: &str) -> String {
+    format!("{}-{name}.png", k + 1)
+}
+
+/// The demo's animation of scene `name`.
+fn animation_name(name: &str) -> String {
+    format!("{name}.gif")
+}
+
 /// Re-runs a scene and writes a GIF of it, framed like its final still.
 fn animate(
     name: &str,
@@ -103,8 +118,13 @@ fn animate(
         supersample: 1,
         ..view.clone()
     };
-    let path = out.join(format!("{name}.gif"));
-    let mut gif = GifWriter::create(&path, small.size, (interval * 1000.0).round() as u32)?;
+    let path = out.join(animation_name(name));
+    let mut gif = GifWriter::create_named(
+        &path,
+        "--out",
+        small.size,
+        (interval * 1000.0).round() as u32,
+    )?;
     let result = drive(&mut scene, |_, scene| {
         gif.frame(small.pixels(scene, camera))
     });

@@ -99,15 +99,17 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
             let sim = &scene.simulation;
             let time = hooke::driver::frame_time(scene, frame);
             let s = Summary::of(sim.model(), sim.particles());
-            let v = |v: hooke_core::Vec3| format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z);
+            // `x + 0.0` is `x` but for -0, which becomes 0: no "-0.000000e0" in the table.
+            let z = |x: f64| x + 0.0;
+            let v = |v: hooke_core::Vec3| format!("({:.3}, {:.3}, {:.3})", z(v.x), z(v.y), z(v.z));
             println!(
                 "{frame:>6} {time:>10.4} {:>13.6e} {:>13.6e} {:>26} {:>26} {:>10.4} {:>11.3e}",
-                s.kinetic,
-                s.potential,
+                z(s.kinetic),
+                z(s.potential),
                 v(s.min),
                 v(s.max),
-                s.max_speed,
-                s.max_penetration
+                z(s.max_speed),
+                z(s.max_penetration)
             );
         }
         Ok(())

@@ -67,5 +67,6 @@ pub use particles::{Particles, SANE_BOUND, Vec3};
 pub use simulation::divergence::Divergence;
 pub use simulation::renumber::Renumbering;
 pub use simulation::stability::StabilityEstimate;
+pub use simulation::start::{PushedOut, StartInside};
 pub use simulation::summary::Summary;
 pub use simulation::{RenumberError, Simulation};

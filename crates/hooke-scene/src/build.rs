@@ -3,10 +3,12 @@
 use crate::colliders::{build_collider, response};
 use crate::error::{BuildError, invalid};
 use crate::generators::Lattice;
-use crate::limits::{MAX_PARTICLES, MAX_STEPS, MAX_WIND, particle_count};
+use crate::limits::{
+    MAX_AIR_DENSITY, MAX_PARTICLES, MAX_PENALTY, MAX_STEPS, MAX_WIND, particle_count,
+};
 use crate::scene::{Body, ColliderGeometry, Scene, Topology};
 use crate::spec::*;
-use hooke_core::{AeroSurface, Air, Gust, Num, SANE_BOUND};
+use hooke_core::{AeroSurface, Air, Gust, Num, SANE_BOUND, StartInside};
 use hooke_core::{
     ColliderSlot, DEFAULT_CLOTH_THICKNESS, DEFAULT_SURFACE_FRICTION, ForceField, Model, Particles,
     Simulation, Spring, SpringKind, Surface, Vec3,
@@ -86,12 +88,26 @@ impl SceneSpec {
             }),
             aero: built.aero,
         };
-        let simulation = Simulation::new(
+        let mut simulation = Simulation::new(
             built.particles,
             model,
             self.simulation.integrator.0,
             self.simulation.dt.get(),
         );
+        let pushed_out = simulation.push_out_start().map_err(|e| {
+            let particle = match &e {
+                StartInside::Through(i, ..) | StartInside::Stuck(i, ..) => *i,
+            };
+            let b = built
+                .bodies
+                .iter()
+                .position(|b| b.range.contains(&particle))
+                .unwrap_or(0);
+            invalid(
+                format!("body[{b}] '{}'", built.bodies[b].name),
+                e.to_string(),
+            )
+        })?;
         Ok(Scene {
             spec: self.clone(),
             simulation,
@@ -99,6 +115,7 @@ impl SceneSpec {
             every,
             bodies: built.bodies,
             colliders: geometry,
+            pushed_out,
         })
     }
 
@@ -205,6 +222,20 @@ impl SceneSpec {
             // Penalty forces need an inside: a mesh under one must be a closed solid. The
             // velocity responses also catch crossings, so open sheets work with them.
             let solid = matches!(spec.response, ResponseSpec::Penalty { .. });
+            if let ResponseSpec::Penalty { kc, dc } = spec.response {
+                for (name, value, unit) in [("kc", kc.get(), "N/m"), ("dc", dc.get(), "N·s/m")] {
+                    if value > MAX_PENALTY {
+                        return Err(invalid(
+                            format!("{key}.response.{name}"),
+                            format!(
+                                "{} {unit} is beyond what a step can follow or the energy can \
+                                 hold: expected at most {MAX_PENALTY:e} {unit}",
+                                Num(value)
+                            ),
+                        ));
+                    }
+                }
+            }
             let (shape, geo) = build_collider(&spec.shape, &key, base, centroid, solid)?;
             slots.push(ColliderSlot {
                 shape,
@@ -319,6 +350,17 @@ fn place_particles(
 
 /// Refuses air whose wind (steady plus the gust's largest change) reaches [`MAX_WIND`].
 fn check_air(air: &AirSpec) -> Result<(), BuildError> {
+    let density = air.density.get();
+    if density > MAX_AIR_DENSITY {
+        return Err(invalid(
+            "simulation.air.density",
+            format!(
+                "{} kg/m³ is denser than any fluid (water is 1000, mercury 13,534): expected at \
+                 most {MAX_AIR_DENSITY:e} kg/m³ (sea-level air is 1.225)",
+                Num(density)
+            ),
+        ));
+    }
     let wind = vec3(&air.wind);
     let gust = air.gust.map_or(Vec3::zeros(), |g| vec3(&g.amplitude));
     let fastest = wind.norm() + gust.norm();

@@ -25,3 +25,13 @@ pub(crate) fn particle_count(shape: &ShapeSpec) -> Option<usize> {
 /// The fastest wind a scene may blow, m/s: the speed of sound in air at 20 °C. The air
 /// model is incompressible pressure drag, which means nothing at or beyond it.
 pub const MAX_WIND: f64 = 343.0;
+
+/// The densest air a scene may have, kg/m³: denser than any liquid at hand (mercury is
+/// 13,534). Beyond it a typo is the likely cause, and `½ ρ |u|²` soon leaves what the
+/// solver's step sizes can follow.
+pub const MAX_AIR_DENSITY: f64 = 2.0e4;
+
+/// The stiffest penalty collider, N/m, and its strongest damping, N·s/m: a gram-weight
+/// particle on 1e12 N/m rings at 3e7 rad/s, which asks steps under 1e-7 s, and past it the
+/// penalty energy of a deep contact leaves the range of the numbers.
+pub const MAX_PENALTY: f64 = 1.0e12;

@@ -64,4 +64,7 @@ pub struct Scene {
     pub bodies: Vec<Body>,
     /// Collider geometry, in the order of the scene file.
     pub colliders: Vec<ColliderGeometry>,
+    /// The particles moved out of velocity-level colliders before the first step, per
+    /// collider (see [`hooke_core::Simulation::push_out_start`]); said as warnings.
+    pub pushed_out: Vec<hooke_core::PushedOut>,
 }

@@ -2,7 +2,7 @@
 //! frame comes.
 
 use crate::error::Result;
-use crate::image_out::{GifWriter, View, write_png};
+use crate::image_out::{GifWriter, View, write_png_named};
 use crate::output::{frame_name, prepare_frame_folder};
 use hooke_scene::Scene;
 use std::path::PathBuf;
@@ -69,7 +69,7 @@ impl crate::Sink for Frames {
         });
         let image = self.view.pixels(scene, &camera);
         if let Some(d) = &self.dir {
-            write_png(&d.join(frame_name(frame, "png")), &image)?;
+            write_png_named(&d.join(frame_name(frame, "png")), "--frames", &image)?;
         }
         if let Some(g) = self.gif.as_mut() {
             g.frame(image)?;

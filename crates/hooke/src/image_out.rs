@@ -3,7 +3,7 @@
 
 use crate::draw::{Style, draw, frame_camera};
 use crate::error::{Context, Result};
-use crate::output::{OutputFile, write_atomic};
+use crate::output::{OutputFile, write_atomic, write_named};
 use hooke_render::{Camera, RenderOptions, render};
 use hooke_scene::Scene;
 use image::{ImageFormat, RgbaImage};
@@ -134,13 +134,24 @@ impl View {
     }
 }
 
-/// Encodes and writes a PNG atomically.
+/// Encodes and writes a PNG atomically at a path the user gave.
 pub fn write_png(path: &Path, image: &RgbaImage) -> Result<()> {
+    write_atomic(path, &png_bytes(path, image)?)
+}
+
+/// Encodes and writes a PNG atomically at `path`, a name hooke chose inside a folder it
+/// writes (given with option `flag`; see [`crate::output::named`]).
+pub fn write_png_named(path: &Path, flag: &str, image: &RgbaImage) -> Result<()> {
+    write_named(path, flag, &png_bytes(path, image)?)
+}
+
+/// `image` encoded as a PNG, for `path`.
+pub(crate) fn png_bytes(path: &Path, image: &RgbaImage) -> Result<Vec<u8>> {
     let mut bytes = Vec::new();
     image
         .write_to(&mut Cursor::new(&mut bytes), ImageFormat::Png)
         .with_context(|| format!("cannot encode {}", path.display()))?;
-    write_atomic(path, &bytes)
+    Ok(bytes)
 }
 
 /// A looping GIF animation written frame by frame; it appears at its path only on
@@ -158,10 +169,19 @@ impl GifWriter {
     /// Starts a GIF of `size` pixels showing each frame for `frame_ms` milliseconds
     /// (rounded to GIF's 10 ms, at least 20 ms: viewers slow faster frames down).
     pub fn create(path: &Path, size: (u32, u32), frame_ms: u32) -> Result<Self> {
+        Self::start(OutputFile::create(path)?, path, size, frame_ms)
+    }
+
+    /// As [`GifWriter::create`], at `path`, a name hooke chose inside a folder it writes
+    /// (given with option `flag`; see [`crate::output::named`]).
+    pub fn create_named(path: &Path, flag: &str, size: (u32, u32), frame_ms: u32) -> Result<Self> {
+        Self::start(OutputFile::create_named(path, flag)?, path, size, frame_ms)
+    }
+
+    fn start(file: OutputFile, path: &Path, size: (u32, u32), frame_ms: u32) -> Result<Self> {
         let cannot = || format!("cannot write {}", path.display());
         let w = u16::try_from(size.0).with_context(cannot)?;
         let h = u16::try_from(size.1).with_context(cannot)?;
-        let file = OutputFile::create(path)?;
         let mut encoder = gif::Encoder::new(file, w, h, &[]).with_context(cannot)?;
         encoder
             .set_repeat(gif::Repeat::Infinite)

@@ -171,13 +171,15 @@ fn segment_through_triangle(
 /// The closest points of segment `pq` and triangle `abc`: the segment parameter `s` and the
 /// barycentric weights of the triangle's point. Where the segment passes through the
 /// triangle, the crossing point (distance zero).
-pub(crate) fn segment_triangle(
-    p: &Vec3,
-    q: &Vec3,
-    a: &Vec3,
-    b: &Vec3,
-    c: &Vec3,
-) -> (f64, [f64; 3]) {
+///
+/// ```
+/// use hooke_core::contact::proximity::segment_triangle;
+/// use hooke_core::Vec3;
+/// let (a, b, c) = (Vec3::zeros(), Vec3::x(), Vec3::z());
+/// let (s, w) = segment_triangle(&Vec3::new(0.25, 1.0, 0.25), &Vec3::new(0.25, -1.0, 0.25), &a, &b, &c);
+/// assert_eq!((s, w), (0.5, [0.5, 0.25, 0.25])); // through the triangle half way
+/// ```
+pub fn segment_triangle(p: &Vec3, q: &Vec3, a: &Vec3, b: &Vec3, c: &Vec3) -> (f64, [f64; 3]) {
     if let Some(hit) = segment_through_triangle(p, q, a, b, c) {
         return hit;
     }

@@ -32,9 +32,11 @@ pub struct Divergence {
     pub integrator: Integrator,
     /// The step size in use.
     pub dt: f64,
-    /// The integrator's estimated stable step at the step's start, seconds (infinite for
-    /// the implicit integrator and for systems without springs).
+    /// The integrator's estimated stable step at the run's start, seconds (infinite for
+    /// the implicit integrator and for systems without springs): what `hooke check` says.
     pub stable_dt: f64,
+    /// The same estimate at the state the diverging step started from, seconds.
+    pub step_stable_dt: f64,
     /// A step size expected to be stable: half the estimate, or half the step in use when
     /// that is smaller (the estimate did not explain the divergence, so take margin).
     pub suggested_dt: f64,
@@ -46,6 +48,8 @@ pub(crate) struct StepEnd<'a> {
     pub model: &'a Model,
     /// The particles as the step left them.
     pub particles: &'a Particles,
+    /// The particles as the run started.
+    pub initial: &'a Particles,
     /// The step's start positions, if the integrator saved them; otherwise they are
     /// recovered by undoing `x' = x + dt v'` (symplectic Euler), up to rounding.
     pub start: Option<&'a [Vec3]>,
@@ -87,7 +91,8 @@ pub(crate) fn check(end: StepEnd<'_>) -> Result<(), Divergence> {
     } else {
         StabilityEstimate::bound(end.model, &at_start)
     };
-    let stable_dt = estimate.max_dt(end.integrator);
+    let step_stable_dt = estimate.max_dt(end.integrator);
+    let stable_dt = StabilityEstimate::of(end.model, end.initial).max_dt(end.integrator);
     Err(Divergence {
         step: end.step,
         time: end.step as f64 * end.dt,
@@ -96,7 +101,8 @@ pub(crate) fn check(end: StepEnd<'_>) -> Result<(), Divergence> {
         integrator: end.integrator,
         dt: end.dt,
         stable_dt,
-        suggested_dt: 0.5 * stable_dt.min(end.dt),
+        step_stable_dt,
+        suggested_dt: 0.5 * stable_dt.min(step_stable_dt).min(end.dt),
     })
 }
 
@@ -124,10 +130,32 @@ impl Divergence {
             self.particle,
             self.what
         );
-        let advice = if self.dt > self.stable_dt {
+        // The estimate at the run's start is `hooke check`'s; the diverging step's may be
+        // smaller where the state has since stretched or sped up.
+        let here = if self.step_stable_dt < 0.95 * self.stable_dt {
             format!(
-                "the {} step dt = {} s exceeds its stable estimate of {:.3e} s; use dt = {:.3e} s \
-                 or smaller",
+                " ({:.3e} s at the state the step started from)",
+                self.step_stable_dt
+            )
+        } else {
+            String::new()
+        };
+        let advice = if self.dt <= self.stable_dt && self.dt > self.step_stable_dt {
+            format!(
+                "the {} step dt = {} s is within its stable estimate of {:.3e} s at the run's \
+                 start (as hooke check says), but not the {:.3e} s of the state the step started \
+                 from, which had already run away: look for forces that stiffen as the state \
+                 moves (a strong wind, a stiff penalty collider); dt = {:.3e} s may help",
+                self.integrator,
+                Num(self.dt),
+                self.stable_dt,
+                self.step_stable_dt,
+                self.suggested_dt
+            )
+        } else if self.dt > self.stable_dt {
+            format!(
+                "the {} step dt = {} s exceeds its stable estimate of {:.3e} s at the run's start \
+                 (as hooke check says){here}; use dt = {:.3e} s or smaller",
                 self.integrator,
                 Num(self.dt),
                 self.stable_dt,

@@ -6,7 +6,9 @@
 
 pub(crate) mod divergence;
 pub(crate) mod renumber;
+pub(crate) mod runaway;
 pub(crate) mod stability;
+pub(crate) mod start;
 pub(crate) mod summary;
 
 use crate::assembly::kernel::Kernel;
@@ -18,6 +20,7 @@ use crate::parallel;
 use crate::particles::{Particles, Vec3};
 use divergence::{Divergence, StepEnd};
 use renumber::Renumbering;
+use runaway::EnergyWatch;
 use stability::StabilityEstimate;
 
 /// A mass-spring system being simulated.
@@ -48,6 +51,11 @@ pub struct Simulation {
     /// stays on the calling thread instead of hopping onto a pool worker, which would cost
     /// more than the step.
     inline: bool,
+    /// The watch for energy from nowhere ([`runaway`]).
+    watch: EnergyWatch,
+    /// The state the run started from, for the stable-step estimate a divergence names
+    /// (the one `hooke check` gives).
+    initial: Particles,
 }
 
 /// Why [`Simulation::renumber`] refused a renumbering.
@@ -85,13 +93,16 @@ impl Simulation {
             // One partition of springs (see `partition_size`).
             && model.springs.len() <= crate::assembly::PARTITION_MIN / 4
             && !model.surfaces.iter().any(crate::model::surface::Surface::is_active);
+        let watch = EnergyWatch::new(&model, &particles, dt);
         Self {
+            initial: particles.clone(),
             particles,
             model,
             integrator,
             dt,
             step: 0,
             workspace,
+            watch,
             contacts,
             last: StepReport {
                 saved_start: false,
@@ -188,6 +199,7 @@ impl Simulation {
             return Err(RenumberError::Body);
         }
         self.particles = r.particles(&self.particles);
+        self.initial = r.particles(&self.initial);
         r.model(&mut self.model);
         let kernel = self.workspace.kernel;
         self.workspace = Workspace {
@@ -197,6 +209,7 @@ impl Simulation {
         self.workspace
             .ensure(&self.model, self.particles.len(), self.integrator);
         self.contacts = ContactState::new(self.particles.len());
+        self.watch.renumbered();
         self.last = StepReport {
             saved_start: false,
             verdict: None,
@@ -268,13 +281,23 @@ impl Simulation {
         divergence::check(StepEnd {
             model: &self.model,
             particles: &self.particles,
+            initial: &self.initial,
             start: self.workspace.start_positions(report),
             // The integrator's verdict stands unless contacts moved particles after it.
             verdict: if moved { None } else { report.verdict },
             step: self.step,
             integrator: self.integrator,
             dt: self.dt,
-        })
+        })?;
+        self.watch.check(
+            &self.model,
+            &self.particles,
+            &self.initial,
+            self.step,
+            self.time(),
+            self.integrator,
+            self.dt,
+        )
     }
 
     /// Advances `steps` steps, stopping at the first divergence.
@@ -285,6 +308,13 @@ impl Simulation {
             }
             Ok(())
         })
+    }
+
+    /// Whether a run whose energy grows far beyond what was supplied stops as diverged
+    /// (docs/physics.md §7, "Energy from nowhere"); on by default. Off, a scheme's own energy growth
+    /// can be watched to its end, as a test of the scheme does.
+    pub fn watch_energy(&mut self, on: bool) {
+        self.watch.enabled = on;
     }
 
     /// The highest-frequency estimate of the system at its current state.

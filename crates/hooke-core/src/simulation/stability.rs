@@ -4,7 +4,10 @@
 //! linearised at the given positions (each spring contributes `ks u uᵀ` between its ends; the
 //! geometric term `ks (1 - l/L)` is left out, it is small near rest). It is found by power
 //! iteration from a fixed start vector, so the estimate is deterministic. Penalty colliders add
-//! `kc` to every particle's diagonal, a bound for the particles that touch them.
+//! `kc` to every particle's diagonal, a bound for the particles that touch them, and the air
+//! its stiffness at the strongest wind (see `diagonal_stiffness`). Damping limits the step
+//! too: `γ_max`, a bound on the fastest damping rate, must keep `dt γ_max` inside the
+//! scheme's real stability interval.
 
 use crate::collider::response::Response;
 use crate::integrator::Integrator;
@@ -12,11 +15,17 @@ use crate::model::Model;
 use crate::parallel;
 use crate::particles::{Particles, Vec3};
 
-/// The highest angular frequency of a system and the explicit step limits it implies.
+/// The highest angular frequency of a system, its fastest damping rate, and the explicit
+/// step limits they imply.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StabilityEstimate {
     /// Highest angular frequency `ω_max` in rad/s (zero for a system without springs).
     pub omega_max: f64,
+    /// Fastest damping rate `γ_max` in 1/s: a Gershgorin bound on the largest eigenvalue of
+    /// `M⁻¹ C`, with `C` the velocity Jacobian of spring damping, drag, penalty damping and
+    /// the air (linearised at the state's velocities against the strongest wind the air
+    /// blows). An explicit scheme also needs `dt γ_max` inside its real stability interval.
+    pub damping_max: f64,
 }
 
 /// Iterations of the power method; the estimate converges from below, and 60 iterations put
@@ -28,8 +37,12 @@ impl StabilityEstimate {
     pub fn of(model: &Model, particles: &Particles) -> Self {
         let n = particles.len();
         let penalty_k = penalty_stiffness(model);
-        if n == 0 || (model.springs.is_empty() && penalty_k == 0.0) {
-            return Self { omega_max: 0.0 };
+        let damping_max = damping_rate(model, particles);
+        if n == 0 || (model.springs.is_empty() && penalty_k == 0.0 && model.air.is_none()) {
+            return Self {
+                omega_max: 0.0,
+                damping_max,
+            };
         }
         // A fixed, non-symmetric start vector so no mode is missed by symmetry.
         let mut u: Vec<Vec3> = (0..n)
@@ -44,9 +57,10 @@ impl StabilityEstimate {
             .collect();
         let mut w = vec![Vec3::zeros(); n];
         let mut lambda = 0.0;
+        let diagonal = diagonal_stiffness(model, particles, penalty_k);
         for _ in 0..POWER_ITERATIONS {
             normalise(&mut u);
-            apply(model, particles, penalty_k, &u, &mut w);
+            apply(model, particles, &diagonal, &u, &mut w);
             lambda = parallel::dot(&u, &w);
             std::mem::swap(&mut u, &mut w);
         }
@@ -54,6 +68,7 @@ impl StabilityEstimate {
         let growth = parallel::dot(&u, &u).sqrt();
         Self {
             omega_max: lambda.max(growth).max(0.0).sqrt(),
+            damping_max,
         }
     }
 
@@ -78,7 +93,7 @@ impl StabilityEstimate {
     /// ```
     pub fn bound(model: &Model, particles: &Particles) -> Self {
         let penalty_k = penalty_stiffness(model);
-        let mut row = vec![penalty_k; particles.len()];
+        let mut row = diagonal_stiffness(model, particles, penalty_k);
         for s in &model.springs {
             row[s.i as usize] += 2.0 * s.ks;
             row[s.j as usize] += 2.0 * s.ks;
@@ -92,18 +107,129 @@ impl StabilityEstimate {
             .fold(0.0, f64::max);
         Self {
             omega_max: lambda.sqrt(),
+            damping_max: damping_rate(model, particles),
         }
     }
 
     /// The largest stable step of `integrator` in seconds: its
-    /// [`Integrator::stability_radius`] over `ω_max`; infinite where the scheme has no such
-    /// limit (backward Euler) or the system no springs.
+    /// [`Integrator::stability_radius`] over `ω_max`, and its real stability interval over
+    /// `γ_max`, whichever is smaller; infinite where the scheme has no such limit (backward
+    /// Euler) or the system neither springs nor damping.
     pub fn max_dt(&self, integrator: Integrator) -> f64 {
-        if self.omega_max == 0.0 {
+        let radius = integrator.stability_radius();
+        if !radius.is_finite() {
             return f64::INFINITY;
         }
-        integrator.stability_radius() / self.omega_max
+        let oscillation = if self.omega_max == 0.0 {
+            f64::INFINITY
+        } else {
+            radius / self.omega_max
+        };
+        let damping = if self.damping_max == 0.0 {
+            f64::INFINITY
+        } else {
+            real_interval(integrator) / self.damping_max
+        };
+        oscillation.min(damping)
     }
+}
+
+/// How far along the negative real axis `dt λ` may reach and the scheme stay stable: 2 for
+/// the Euler schemes and midpoint (`|1 - z| ≤ 1`, `|1 - z + z²/2| ≤ 1`), 2.785 for RK4.
+fn real_interval(integrator: Integrator) -> f64 {
+    match integrator {
+        Integrator::Rk4 => 2.785,
+        _ => 2.0,
+    }
+}
+
+/// [`StabilityEstimate::damping_max`]: per free particle, the damping coefficients acting on
+/// it summed (twice each spring's `kd`, as Gershgorin's row sum counts both ends), over its
+/// mass; the largest.
+fn damping_rate(model: &Model, p: &Particles) -> f64 {
+    let n = p.len();
+    let penalty_dc: f64 = model
+        .colliders
+        .iter()
+        .map(|c| match c.response {
+            Response::Penalty { dc, .. } => dc,
+            _ => 0.0,
+        })
+        .sum();
+    let mut row = vec![model.drag + penalty_dc; n];
+    for s in &model.springs {
+        row[s.i as usize] += 2.0 * s.kd;
+        row[s.j as usize] += 2.0 * s.kd;
+    }
+    if let Some(air) = &model.air {
+        // The strongest wind the air blows, and each triangle's relative speed at it: a
+        // triangle's force `½ ρ A C |u| u` changes by at most `ρ A (C_d + C_l) |u|` per unit
+        // of its mean velocity, a corner moves that mean by a third and takes a third of it.
+        let wind = air.wind.norm() + air.gust.map_or(0.0, |g| g.amplitude.norm());
+        for surface in &model.aero {
+            for t in &surface.triangles {
+                let [a, b, c] = t.map(|i| i as usize);
+                if c >= n || a >= n || b >= n {
+                    continue;
+                }
+                let area = 0.5 * (p.x[b] - p.x[a]).cross(&(p.x[c] - p.x[a])).norm();
+                let mean = (p.v[a] + p.v[b] + p.v[c]) * (1.0 / 3.0);
+                let speed = mean.norm() + wind;
+                let k = air.density * area * (surface.drag.abs() + surface.lift.abs()) * speed;
+                if k.is_finite() {
+                    for i in [a, b, c] {
+                        row[i] += k / 3.0;
+                    }
+                }
+            }
+        }
+    }
+    row.iter()
+        .zip(&p.mass)
+        .zip(&p.inv_mass)
+        .filter(|(_, inv)| **inv != 0.0)
+        .map(|((k, m), _)| k / m)
+        .fold(0.0, f64::max)
+}
+
+/// What each particle feels besides its springs, as a stiffness on the diagonal of `K`: the
+/// penalty colliders' `kc` (the most a particle touching all of them feels) and the air's.
+/// The air turns a triangle's force with its normal, which its corners turn: the force
+/// `½ ρ A C |u| (u·n)` changes with a corner's position by at most `½ ρ C |u|² L` (`L` the
+/// triangle's longest edge, `C = |C_d| + |C_l|`), and each corner takes its third of the
+/// force, so the row of a corner adds that much per triangle, at the strongest wind.
+fn diagonal_stiffness(model: &Model, p: &Particles, penalty_k: f64) -> Vec<f64> {
+    let n = p.len();
+    let mut row = vec![penalty_k; n];
+    if let Some(air) = &model.air {
+        let wind = air.wind.norm() + air.gust.map_or(0.0, |g| g.amplitude.norm());
+        for surface in &model.aero {
+            for t in &surface.triangles {
+                let [a, b, c] = t.map(|i| i as usize);
+                if a >= n || b >= n || c >= n {
+                    continue;
+                }
+                let longest = (p.x[b] - p.x[a])
+                    .norm()
+                    .max((p.x[c] - p.x[b]).norm())
+                    .max((p.x[a] - p.x[c]).norm());
+                let mean = (p.v[a] + p.v[b] + p.v[c]) * (1.0 / 3.0);
+                let speed = mean.norm() + wind;
+                let k = 0.5
+                    * air.density
+                    * (surface.drag.abs() + surface.lift.abs())
+                    * speed
+                    * speed
+                    * longest;
+                if k.is_finite() {
+                    for i in [a, b, c] {
+                        row[i] += k;
+                    }
+                }
+            }
+        }
+    }
+    row
 }
 
 /// The penalty colliders' stiffness, summed: the most a particle touching all of them feels.
@@ -118,9 +244,9 @@ fn penalty_stiffness(model: &Model) -> f64 {
         .sum()
 }
 
-fn apply(model: &Model, p: &Particles, penalty_k: f64, u: &[Vec3], out: &mut [Vec3]) {
-    for (o, x) in out.iter_mut().zip(u) {
-        *o = x * penalty_k;
+fn apply(model: &Model, p: &Particles, diagonal: &[f64], u: &[Vec3], out: &mut [Vec3]) {
+    for ((o, x), k) in out.iter_mut().zip(u).zip(diagonal) {
+        *o = x * *k;
     }
     for s in &model.springs {
         let (i, j) = (s.i as usize, s.j as usize);

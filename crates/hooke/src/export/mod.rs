@@ -121,7 +121,11 @@ impl Target {
                         path.display()
                     );
                 }
-                check_output_file(&path.with_extension("obj"), "--export (its mesh)", &["obj"])?;
+                // The mesh's name is chosen by hooke, not by the user: nothing planted there
+                // is written through.
+                let mesh = path.with_extension("obj");
+                crate::output::check_named(&mesh, "--export (its mesh)")?;
+                check_output_file(&mesh, "--export (its mesh)", &["obj"])?;
                 Target::Pc2 {
                     path: path.to_path_buf(),
                     body: body.map(str::to_string),

@@ -123,7 +123,7 @@ impl crate::Sink for ObjExport {
     /// Writes frame `frame` of `scene` at its current state.
     fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
         let path = self.path(frame);
-        let mut file = OutputFile::create(&path)?;
+        let mut file = OutputFile::create_named(&path, "--export")?;
         write_frame(file.writer(), frame, scene, &self.colliders)
             .with_context(|| format!("cannot write {}", path.display()))?;
         file.commit()?;

@@ -74,7 +74,7 @@ impl Pc2Export {
                 ))
             })?;
         let mesh = path.with_extension("obj");
-        let mut obj = OutputFile::create(&mesh)?;
+        let mut obj = OutputFile::create_named(&mesh, "--export (its mesh)")?;
         let sim = &scene.simulation;
         let x = &sim.particles().x;
         let springs = &sim.model().springs;

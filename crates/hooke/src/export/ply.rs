@@ -179,7 +179,7 @@ impl crate::Sink for PlyExport {
                 n: super::f32s(n),
             }));
         let path = self.path(frame);
-        let mut file = OutputFile::create(&path)?;
+        let mut file = OutputFile::create_named(&path, "--export")?;
         self.write(file.writer(), frame, scene)
             .with_context(|| format!("cannot write {}", path.display()))?;
         file.commit()?;

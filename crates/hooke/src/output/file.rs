@@ -76,7 +76,8 @@ fn sweep(dir: &Path) -> usize {
         let name = entry.file_name();
         let dead = writer_of(&name.to_string_lossy())
             .is_some_and(|pid| pid != std::process::id() && !running(pid));
-        if dead && entry.file_type().is_ok_and(|t| t.is_file()) {
+        // A link or a second name planted under a temporary's name is left alone.
+        if dead && entry.metadata().is_ok_and(|m| super::named::is_plain(&m)) {
             removed += usize::from(std::fs::remove_file(entry.path()).is_ok());
         }
     }
@@ -158,6 +159,14 @@ impl OutputFile {
         }
     }
 
+    /// Starts writing `path`, a name Hooke chose inside a folder it writes (given with
+    /// option `flag`): refused unless nothing is there or a plain file of this user's (see
+    /// [`super::named`]); the file is renamed over that name itself, never through a link.
+    pub fn create_named(path: &Path, flag: &str) -> Result<Self> {
+        super::named::check_named(path, flag)?;
+        Self::temporary(folder(path), path.to_path_buf(), Some(path.to_path_buf()))
+    }
+
     /// A scratch file for an output to `near`: hidden beside it (or in the system's
     /// temporary folder when `near` is a stream), never committed, removed when dropped.
     pub fn scratch(near: &Path) -> Result<Self> {
@@ -171,18 +180,13 @@ impl OutputFile {
     fn temporary(dir: &Path, shown: PathBuf, target: Option<PathBuf>) -> Result<Self> {
         sweep(dir);
         let temp = temp_in(dir);
-        let file = std::fs::OpenOptions::new()
-            .write(true)
-            .read(true)
-            .create_new(true)
-            .open(&temp)
-            .with_context(|| {
-                format!(
-                    "cannot write {}: cannot create a file in {}",
-                    shown.display(),
-                    dir.display()
-                )
-            })?;
+        let file = super::named::create_new(&temp).with_context(|| {
+            format!(
+                "cannot write {}: cannot create a file in {}",
+                shown.display(),
+                dir.display()
+            )
+        })?;
         lock(&PENDING).push(temp.clone());
         Ok(Self {
             shown,
@@ -268,7 +272,16 @@ impl Write for OutputFile {
 
 /// Writes a whole file atomically (or a stream at once).
 pub fn write_atomic(target: &Path, bytes: &[u8]) -> Result<()> {
-    let mut f = OutputFile::create(target)?;
+    write_all(OutputFile::create(target)?, target, bytes)
+}
+
+/// Writes a whole file atomically at `path`, a name Hooke chose inside a folder it writes
+/// (see [`OutputFile::create_named`]).
+pub fn write_named(path: &Path, flag: &str, bytes: &[u8]) -> Result<()> {
+    write_all(OutputFile::create_named(path, flag)?, path, bytes)
+}
+
+fn write_all(mut f: OutputFile, target: &Path, bytes: &[u8]) -> Result<()> {
     f.writer()
         .write_all(bytes)
         .with_context(|| format!("cannot write {}", target.display()))?;

@@ -3,9 +3,10 @@
 //! however it exits. The file names the holder (process id and command) for the message a
 //! second run gets.
 
+use super::named;
 use crate::error::{Context, Result, bail_output};
-use std::fs::{File, OpenOptions, TryLockError};
-use std::io::{Read, Seek, SeekFrom, Write};
+use std::fs::{File, TryLockError};
+use std::io::{Read, Write};
 use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, Weak};
@@ -61,50 +62,64 @@ impl FolderLock {
 }
 
 impl Held {
+    /// Creates `DIR/.hooke-lock` anew (`O_EXCL | O_NOFOLLOW`: nothing planted there is
+    /// opened through) and locks it. A lock file already there is opened without following
+    /// a link, and only if it is a plain file of this user's with one link: locked by
+    /// another run, that run is named; unlocked, it is an ended run's, and is removed and
+    /// created again — never truncated, never written.
     fn take(dir: &Path, flag: &str) -> Result<Self> {
         let path = dir.join(LOCK_NAME);
+        let cannot = |e: std::io::Error| {
+            crate::Error::output(format!(
+                "{flag} {}: cannot lock the folder: {e}",
+                path.display()
+            ))
+        };
         // A lock file another run removes between our open and our lock is no longer the
         // folder's: try again with the new one.
         for _ in 0..8 {
-            let mut file = OpenOptions::new()
-                .read(true)
-                .write(true)
-                .create(true)
-                .truncate(false)
-                .open(&path)
-                .with_context(|| format!("{flag} {}: cannot create {LOCK_NAME}", dir.display()))?;
+            let mut file = match named::create_new(&path) {
+                Ok(file) => file,
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    let mut file = named::open_existing(&path, flag)?;
+                    match file.try_lock() {
+                        Ok(()) => {
+                            // An ended run's lock: removed while we hold it, so that a run
+                            // opening it meanwhile finds it gone when it gets the lock.
+                            if same_file(&path, &file) {
+                                std::fs::remove_file(&path).map_err(cannot)?;
+                            }
+                            continue;
+                        }
+                        Err(TryLockError::WouldBlock) => {
+                            let mut said = String::new();
+                            let _ = file.read_to_string(&mut said);
+                            let said = said.trim();
+                            bail_output!(
+                                "{flag} {}: the folder is being written by another run, {}; \
+                                 wait for it to end or choose another folder",
+                                dir.display(),
+                                if said.is_empty() {
+                                    "which has not said who it is"
+                                } else {
+                                    said
+                                }
+                            );
+                        }
+                        Err(TryLockError::Error(e)) => return Err(cannot(e)),
+                    }
+                }
+                Err(e) => return Err(cannot(e)),
+            };
             match file.try_lock() {
                 Ok(()) => {}
-                Err(TryLockError::WouldBlock) => {
-                    let mut said = String::new();
-                    let _ = file.read_to_string(&mut said);
-                    let said = said.trim();
-                    bail_output!(
-                        "{flag} {}: the folder is being written by another run, {}; wait for it \
-                         to end or choose another folder",
-                        dir.display(),
-                        if said.is_empty() {
-                            "which has not said who it is"
-                        } else {
-                            said
-                        }
-                    );
-                }
-                Err(TryLockError::Error(e)) => {
-                    return Err(e).with_context(|| {
-                        format!("{flag} {}: cannot lock the folder", dir.display())
-                    });
-                }
+                // Another run took our new file for an ended run's and holds it now.
+                Err(TryLockError::WouldBlock) => continue,
+                Err(TryLockError::Error(e)) => return Err(cannot(e)),
             }
-            let same = std::fs::metadata(&path)
-                .ok()
-                .zip(file.metadata().ok())
-                .is_some_and(|(a, b)| (a.dev(), a.ino()) == (b.dev(), b.ino()));
-            if !same {
+            if !same_file(&path, &file) {
                 continue;
             }
-            file.set_len(0)?;
-            file.seek(SeekFrom::Start(0))?;
             writeln!(file, "{}", holder())
                 .with_context(|| format!("{flag} {}: cannot write {LOCK_NAME}", dir.display()))?;
             return Ok(Self { path, file });
@@ -116,10 +131,21 @@ impl Held {
     }
 }
 
+/// Whether `path` still names the open `file` (and not a link, or another file).
+fn same_file(path: &Path, file: &File) -> bool {
+    std::fs::symlink_metadata(path)
+        .ok()
+        .zip(file.metadata().ok())
+        .is_some_and(|(a, b)| (a.dev(), a.ino()) == (b.dev(), b.ino()))
+}
+
 impl Drop for Held {
     fn drop(&mut self) {
         // Removed while still locked: a run waiting on this file finds it gone and retries.
-        let _ = std::fs::remove_file(&self.path);
+        // Only if the name is still ours: what someone put there since is left alone.
+        if same_file(&self.path, &self.file) {
+            let _ = std::fs::remove_file(&self.path);
+        }
         let _ = self.file.unlock();
     }
 }

@@ -8,13 +8,14 @@ pub mod claims;
 pub mod destination;
 pub mod file;
 pub mod lock;
+pub mod named;
 
-pub use file::{OutputFile, remove_pending, write_atomic};
+pub use file::{OutputFile, remove_pending, write_atomic, write_named};
+pub use named::check_named;
 
 use crate::error::{Context, Result, bail_output};
 use destination::{Destination, destination};
 use lock::FolderLock;
-use std::fs::File;
 use std::path::Path;
 
 /// Checks, before a run, that `path` (given with option `flag`) can take an output file of
@@ -57,7 +58,7 @@ pub fn check_output_file(path: &Path, flag: &str, extensions: &[&str]) -> Result
     // A probe: the folder takes a new file now, not only in principle.
     let dir = destination::folder(target);
     let probe = file::temp_in(dir);
-    File::create(&probe).with_context(|| {
+    named::create_new(&probe).with_context(|| {
         format!(
             "{flag} {}: cannot create a file in {}",
             path.display(),
@@ -71,16 +72,37 @@ pub fn check_output_file(path: &Path, flag: &str, extensions: &[&str]) -> Result
 /// Checks, before a run, that `dir` (given with option `flag`) can be an output folder: it
 /// is one, or nothing is there yet (it is created when the run starts).
 pub fn check_output_folder(dir: &Path, flag: &str) -> Result<()> {
+    use std::os::unix::fs::FileTypeExt;
     if dir.as_os_str() == "-" {
-        bail_output!(
-            "{flag} -: expected a folder; a folder of frames cannot go to standard output"
-        );
+        bail_output!("{flag} -: expected a folder; standard output cannot hold a folder");
     }
     // `file/` does not exist as a path (the file is no folder), but `file` does.
     let text = dir.to_string_lossy();
     let bare = Path::new(text.trim_end_matches(['/', std::path::MAIN_SEPARATOR]));
-    if (dir.exists() && !dir.is_dir()) || (bare.exists() && !bare.is_dir()) {
-        bail_output!("{flag} {}: is a file, expected a folder", dir.display());
+    for path in [dir, bare] {
+        match std::fs::metadata(path) {
+            Ok(meta) if meta.is_dir() => {}
+            Ok(meta) => {
+                let kind = meta.file_type();
+                let what = if kind.is_char_device() || kind.is_block_device() {
+                    "a device"
+                } else if kind.is_fifo() {
+                    "a FIFO"
+                } else if kind.is_socket() {
+                    "a socket"
+                } else {
+                    "a file"
+                };
+                bail_output!("{flag} {}: is {what}, expected a folder", dir.display());
+            }
+            Err(_) if std::fs::symlink_metadata(path).is_ok() => {
+                bail_output!(
+                    "{flag} {}: is a symbolic link to nothing, expected a folder",
+                    dir.display()
+                );
+            }
+            Err(_) => {}
+        }
     }
     Ok(())
 }
@@ -95,22 +117,22 @@ pub fn prepare_frame_folder(dir: &Path, flag: &str, ext: &str) -> Result<(Folder
     std::fs::create_dir_all(dir)
         .with_context(|| format!("{flag} {}: cannot create the folder", dir.display()))?;
     let lock = FolderLock::take(dir, flag)?;
-    let mut removed = 0;
     let entries =
         std::fs::read_dir(dir).with_context(|| format!("{flag} {}: cannot read", dir.display()))?;
+    // Every stale frame is looked at before any is removed: a link, a second name or a
+    // device under a frame's name refuses the run and leaves the folder as it was.
+    let mut stale = Vec::new();
     for entry in entries.flatten() {
-        let name = entry.file_name();
-        let name = name.to_string_lossy();
-        if is_frame_name(&name, ext) {
-            std::fs::remove_file(entry.path()).with_context(|| {
-                format!(
-                    "{flag}: cannot remove the stale frame {}",
-                    entry.path().display()
-                )
-            })?;
-            removed += 1;
+        if is_frame_name(&entry.file_name().to_string_lossy(), ext) {
+            named::check_named(&entry.path(), flag)?;
+            stale.push(entry.path());
         }
     }
+    for path in &stale {
+        std::fs::remove_file(path)
+            .with_context(|| format!("{flag}: cannot remove the stale frame {}", path.display()))?;
+    }
+    let removed = stale.len();
     // Probe that frames can be written.
     check_output_file(&dir.join(frame_name(0, ext)), flag, &[ext])?;
     Ok((lock, removed))

@@ -78,11 +78,17 @@ fn runs(quick: bool) -> Vec<(&'static str, f64)> {
     vec![("cloth-table", t), ("flag", t), ("jello-cube", t)]
 }
 
-/// Every run on one thread and on all; `tick` after each.
+/// The threads the report's parallel runs take: `RAYON_NUM_THREADS` where it is set, as
+/// for every other command, else one per core.
+fn threads() -> Result<usize> {
+    Ok(crate::threads::count(None, "RAYON_NUM_THREADS")?
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(2, |n| n.get())))
+}
+
+/// Every run on one thread and on many (the threads of [`threads`], at least two); `tick`
+/// after each.
 pub(crate) fn determinism(quick: bool, tick: &mut dyn FnMut()) -> Result<Vec<Hashes>> {
-    let many = std::thread::available_parallelism()
-        .map_or(2, |n| n.get())
-        .max(2);
+    let many = threads()?.max(2);
     let one_pool = crate::threads::build(Some(1))?;
     let many_pool = crate::threads::build(Some(many))?;
     let mut out = Vec::new();
@@ -98,10 +104,10 @@ pub(crate) fn determinism(quick: bool, tick: &mut dyn FnMut()) -> Result<Vec<Has
     Ok(out)
 }
 
-/// The cloth-N workload stepped for `budget` of wall time on all threads, and `cloth-table`
+/// The cloth-N workload stepped for `budget` of wall time on the report's threads, and `cloth-table`
 /// for a simulated second (a tenth with `quick`).
 pub(crate) fn speed(quick: bool) -> Result<Speed> {
-    let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
+    let threads = threads()?;
     let pool = crate::threads::build(Some(threads))?;
     pool.install(|| {
         let n = 128;

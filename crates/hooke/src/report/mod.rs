@@ -10,6 +10,7 @@
 mod convergence;
 pub mod crossings;
 mod energy;
+mod folder;
 mod machine;
 mod page;
 mod physics;
@@ -67,8 +68,10 @@ const ENERGY_TOLERANCE: f64 = 0.01;
 
 /// Runs every check and writes the page into `dir` (created if missing).
 pub fn write(dir: &Path, options: &Options) -> Result<Outcome> {
+    let quick = options.quick;
+    let checked = scenes::names(quick);
     crate::output::check_output_folder(dir, "report")?;
-    refuse_foreign_folder(dir)?;
+    folder::check(dir, &checked)?;
     std::fs::create_dir_all(dir).map_err(|e| {
         crate::Error::from(e).context(format!(
             "report {}: cannot create the folder",
@@ -76,8 +79,10 @@ pub fn write(dir: &Path, options: &Options) -> Result<Outcome> {
         ))
     })?;
     let _held = crate::output::lock::FolderLock::take(dir, "report")?;
-    let quick = options.quick;
-    let total = 12 + 1 + 7 + scenes::names(quick).len() as u64 + 5 + 3 + 1;
+    // Again under the lock: another run may have written the folder meanwhile.
+    folder::check(dir, &checked)?;
+    let mut files = folder::Pending::default();
+    let total = 12 + 1 + 7 + checked.len() as u64 + 5 + 3 + 1;
     let bar = reporter().run("report", total);
     let mut done = 0;
     let mut tick = || {
@@ -97,7 +102,7 @@ pub fn write(dir: &Path, options: &Options) -> Result<Outcome> {
     lap("closed forms");
     let energy = energy::runs(quick, &mut tick)?;
     lap("energy");
-    let scenes = scenes::checks(quick, dir, &mut tick)?;
+    let scenes = scenes::checks(quick, &mut files, &mut tick)?;
     lap("scenes");
     let worlds = worlds::runs(quick, &mut tick)?;
     lap("worlds");
@@ -123,37 +128,11 @@ pub fn write(dir: &Path, options: &Options) -> Result<Outcome> {
         seconds,
     };
     report.failures = failures(&report);
-    page::write(dir, &report)?;
+    page::write(&mut files, &report)?;
+    files.commit(dir, &checked)?;
     Ok(Outcome {
-        page: dir.join("index.html"),
+        page: dir.join(folder::PAGE),
         failures: report.failures,
-    })
-}
-
-/// A report replaces its own files: a folder that holds files but no earlier report is the
-/// user's, and is refused rather than written into.
-fn refuse_foreign_folder(dir: &Path) -> Result<()> {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return Ok(());
-    };
-    let names: Vec<String> = entries
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| !n.starts_with(".hooke-"))
-        .collect();
-    if names.is_empty() || names.iter().any(|n| n == "report.json") {
-        return Ok(());
-    }
-    let mut shown: Vec<&str> = names.iter().map(String::as_str).take(3).collect();
-    shown.sort_unstable();
-    Err(crate::Error::Output {
-        message: format!(
-            "report {}: the folder holds other files ({}{}) and no earlier report; choose a \
-             new or empty folder, or an earlier report's",
-            dir.display(),
-            shown.join(", "),
-            if names.len() > 3 { ", …" } else { "" }
-        ),
     })
 }
 
@@ -294,25 +273,6 @@ mod tests {
     }
 
     #[test]
-    fn a_folder_of_other_files_is_refused_and_an_earlier_report_is_not() {
-        let dir = std::env::temp_dir().join(format!("hooke-report-foreign-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        assert!(refuse_foreign_folder(&dir).is_ok(), "an empty folder");
-        std::fs::write(dir.join("thesis.tex"), "mine").unwrap();
-        let e = refuse_foreign_folder(&dir).unwrap_err().to_string();
-        assert!(
-            e.contains("thesis.tex") && e.contains("no earlier report"),
-            "{e}"
-        );
-        std::fs::write(dir.join("report.json"), "{}").unwrap();
-        assert!(
-            refuse_foreign_folder(&dir).is_ok(),
-            "an earlier report's folder"
-        );
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
     fn a_failed_check_is_said_at_the_top_of_the_page_in_red() {
         let mut report = failing();
         report.failures = failures(&report);
@@ -320,7 +280,9 @@ mod tests {
         assert!(report.failures[0].contains("height at rest"));
         let dir = std::env::temp_dir().join(format!("hooke-report-unit-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        page::write(&dir, &report).unwrap();
+        let mut files = folder::Pending::default();
+        page::write(&mut files, &report).unwrap();
+        files.commit(&dir, &[]).unwrap();
         let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
         let banner = html.find("banner fail").expect("a red banner");
         let first_section = html.find("<h2").unwrap();

@@ -3,11 +3,10 @@
 //! only counts the images that loaded, for the browser test; the page reads the same
 //! without it.
 
+use super::folder::{CONVERGENCE, JSON, PAGE, Pending, STABILITY, energy_file};
 use super::{Report, plots};
 use crate::Result;
-use crate::output::write_atomic;
 use std::fmt::Write;
-use std::path::Path;
 
 /// `s` safe inside HTML text.
 fn esc(s: &str) -> String {
@@ -73,20 +72,14 @@ const SCRIPT: &str = r#"addEventListener('load', () => {
   document.body.dataset.images = ok.length + '/' + all.length;
 });"#;
 
-/// Writes the plots, `report.json` and `index.html` into `dir`.
-pub(super) fn write(dir: &Path, r: &Report) -> Result<()> {
-    write_atomic(
-        &dir.join("convergence.svg"),
-        plots::convergence(&r.convergence)?.as_bytes(),
-    )?;
-    write_atomic(
-        &dir.join("stability.svg"),
-        plots::stability(&r.convergence)?.as_bytes(),
-    )?;
+/// Adds the plots, `report.json` and `index.html` to `files`.
+pub(super) fn write(files: &mut Pending, r: &Report) -> Result<()> {
+    files.add(CONVERGENCE, plots::convergence(&r.convergence)?);
+    files.add(STABILITY, plots::stability(&r.convergence)?);
     let json = serde_json::to_string_pretty(r).map_err(|e| crate::Error::Output {
-        message: format!("report.json: {e}"),
+        message: format!("{JSON}: {e}"),
     })?;
-    write_atomic(&dir.join("report.json"), json.as_bytes())?;
+    files.add(JSON, json);
     let mut h = String::new();
     writeln!(
         h,
@@ -128,12 +121,13 @@ pub(super) fn write(dir: &Path, r: &Report) -> Result<()> {
     )?;
     convergence(&mut h, r)?;
     physics(&mut h, r)?;
-    energy(&mut h, dir, r)?;
+    energy(&mut h, files, r)?;
     scenes(&mut h, r)?;
     worlds(&mut h, r)?;
     machine(&mut h, r)?;
     writeln!(h, "<script>{SCRIPT}</script></body></html>")?;
-    write_atomic(&dir.join("index.html"), h.as_bytes())
+    files.add(PAGE, h);
+    Ok(())
 }
 
 fn convergence(h: &mut String, r: &Report) -> Result<()> {
@@ -197,7 +191,7 @@ fn physics(h: &mut String, r: &Report) -> Result<()> {
     Ok(())
 }
 
-fn energy(h: &mut String, dir: &Path, r: &Report) -> Result<()> {
+fn energy(h: &mut String, files: &mut Pending, r: &Report) -> Result<()> {
     writeln!(
         h,
         "<h2 id=energy>Energy</h2><p>Total energy (kinetic, springs, gravity, penalty) over the \
@@ -213,11 +207,8 @@ fn energy(h: &mut String, dir: &Path, r: &Report) -> Result<()> {
     for (name, make) in hooke_scene::builtin::BUILTINS {
         let own = make().simulation.integrator.0.to_string();
         let runs: Vec<_> = r.energy.iter().filter(|e| e.scene == name).collect();
-        let file = format!("energy-{name}.svg");
-        write_atomic(
-            &dir.join(&file),
-            plots::energy(name, &runs, &own)?.as_bytes(),
-        )?;
+        let file = energy_file(name);
+        files.add(file.clone(), plots::energy(name, &runs, &own)?);
         let own_run = runs.iter().find(|e| e.integrator == own);
         let caption = match own_run {
             Some(e) if e.closed => format!(

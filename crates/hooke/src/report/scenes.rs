@@ -3,6 +3,7 @@
 //! allowed) and its smallest gap to a collider.
 
 use super::crossings::{self, Tri};
+use super::folder::Pending;
 use super::pixels::compare;
 use crate::Result;
 use crate::image_out::View;
@@ -11,6 +12,7 @@ use hooke_core::Vec3;
 use hooke_core::contact::proximity::point_triangle;
 use hooke_scene::{Overrides, Scene};
 use serde::Serialize;
+use std::path::Path;
 
 /// The golden stills of `golden/`, built into the binary so the report needs no checkout.
 const GOLDEN: [(&str, &[u8]); 7] = [
@@ -134,7 +136,7 @@ impl SceneCheck {
 
 /// Runs built-in `name` to its still, checking contacts on every frame, and compares the
 /// still with its golden; the images go to `dir`.
-fn check(name: &str, golden: &[u8], dir: &std::path::Path) -> Result<SceneCheck> {
+fn check(name: &str, golden: &[u8], files: &mut Pending) -> Result<SceneCheck> {
     let mut scene = crate::source::build(name, &Overrides::default())?;
     let steps = still_steps(name, &scene);
     let colliders: Vec<Tri> = crate::export::collider_triangles(&scene)
@@ -178,10 +180,11 @@ fn check(name: &str, golden: &[u8], dir: &std::path::Path) -> Result<SceneCheck>
     } else {
         (actual.len() / 4, actual.clone())
     };
-    let file = |kind: &str| format!("scene-{name}-{kind}.png");
-    crate::image_out::write_png(&dir.join(file("still")), &actual)?;
-    crate::image_out::write_png(&dir.join(file("golden")), &golden)?;
-    crate::image_out::write_png(&dir.join(file("diff")), &diff)?;
+    let file = |kind: &str| super::folder::scene_file(name, kind);
+    for (kind, image) in [("still", &actual), ("golden", &golden), ("diff", &diff)] {
+        let bytes = crate::image_out::png_bytes(Path::new(&file(kind)), image)?;
+        files.add(file(kind), bytes);
+    }
     Ok(SceneCheck {
         name: name.to_string(),
         time: scene.simulation.time(),
@@ -209,13 +212,13 @@ pub(crate) fn names(quick: bool) -> Vec<&'static str> {
 /// Every scene of [`names`], `tick` after each.
 pub(crate) fn checks(
     quick: bool,
-    dir: &std::path::Path,
+    files: &mut Pending,
     tick: &mut dyn FnMut(),
 ) -> Result<Vec<SceneCheck>> {
     let mut out = Vec::new();
     for name in names(quick) {
         let golden = GOLDEN.iter().find(|(n, _)| *n == name).unwrap().1;
-        out.push(check(name, golden, dir)?);
+        out.push(check(name, golden, files)?);
         tick();
     }
     Ok(out)
