@@ -153,6 +153,15 @@ fn absurd_air_and_penalty_stiffness_are_refused_with_their_key() {
     set(&mut flag, "simulation.air.density", "1e100");
     let e = build(&flag).unwrap_err().to_string();
     assert!(e.contains("simulation.air.density"), "{e}");
+    for dt in ["1e-160", "1e160", "1e-16"] {
+        let mut chain = hooke_scene::builtin::builtin("chain").unwrap();
+        set(&mut chain, "simulation.dt", dt);
+        let e = build(&chain).unwrap_err().to_string();
+        assert!(
+            e.contains("simulation.dt") && e.contains("represent"),
+            "{dt}: {e}"
+        );
+    }
     // A course world: its box and plane are penalty colliders.
     let world = crate::common::root().join("assets/worlds/jello.w");
     let mut jelly = hooke_scene::world::load_world(&world)

@@ -54,12 +54,15 @@ pub enum Bench {
         json: bool,
     },
     /// Any scene (built-in, .toml or .w world): steps per second with its own integrator.
+    /// Explicit integrators are timed for `--steps` after 100 warm-up steps; the large-step
+    /// ones (implicit, vbd) from the scene's start, landing included, for its whole run (or
+    /// `--steps`), since at their step a warm-up would skip seconds of what is simulated.
     Scene {
         /// Built-in name, .toml scene or .w world.
         scene: String,
-        /// Measured steps.
-        #[arg(long, default_value_t = 20_000)]
-        steps: u64,
+        /// Measured steps (default: 20000; for implicit and vbd the scene's whole run).
+        #[arg(long)]
+        steps: Option<u64>,
         /// Integrator (default: the scene's).
         #[arg(long)]
         integrator: Option<Integrator>,
@@ -225,6 +228,17 @@ struct SceneFigures {
     /// Average block-descent iterations and contact detections per step (vbd only).
     vbd_iterations_per_step: f64,
     vbd_detections_per_step: f64,
+    /// The solver's iterations per step: block descent's, or conjugate gradients' (0 for the
+    /// explicit integrators).
+    iterations_per_step: f64,
+    /// Steps that ended at an iteration cap without meeting the solver's stopping rule.
+    capped_steps: u64,
+    /// The largest residual a block-descent step ended with: the force left on a free
+    /// particle over its weight (docs/physics.md §4.1; 0 for the other integrators).
+    max_residual: f64,
+    /// Whether the steps were timed from the scene's start (large-step integrators) or
+    /// after a warm-up of 100 steps.
+    from_start: bool,
     /// Wall seconds per simulated second.
     wall_per_simulated_s: f64,
     integrator: String,
@@ -457,29 +471,46 @@ fn scene_steps(
     name: &str,
     overrides: &Overrides,
     kernel: Option<Kernel>,
-    steps: u64,
+    steps: Option<u64>,
     json: bool,
 ) -> Result<ExitCode> {
-    if steps == 0 {
+    if steps == Some(0) {
         bail!("--steps: expected at least 1");
     }
     let mut scene = source::build(name, overrides)?;
+    let whole_run = scene.steps;
     let sim = &mut scene.simulation;
     use_kernel(sim, kernel)?;
-    sim.advance(steps.min(100))?;
+    let from_start = matches!(sim.integrator(), Integrator::Implicit | Integrator::Vbd);
+    let steps = match steps {
+        Some(n) => n,
+        None if from_start => whole_run,
+        None => 20_000,
+    };
+    if !from_start {
+        sim.advance(steps.min(100))?;
+    }
     let mut cg_iterations = 0;
     let (mut vbd_iterations, mut vbd_detections) = (0, 0);
+    let (mut capped_steps, mut max_residual) = (0, 0.0f64);
     let contacts_before = sim.contact_stats();
     let (times, seconds) = StepTimes::run(sim, steps, |sim| {
-        cg_iterations += sim.workspace().cg_iterations();
-        vbd_iterations += sim.workspace().vbd_iterations();
-        vbd_detections += sim.workspace().vbd_detections();
+        let w = sim.workspace();
+        cg_iterations += w.cg_iterations();
+        vbd_iterations += w.vbd_iterations();
+        vbd_detections += w.vbd_detections();
+        capped_steps += u64::from(w.capped());
+        max_residual = max_residual.max(w.vbd_residual());
     })?;
     let contacts = sim.contact_stats();
     let figures = SceneFigures {
         cg_iterations_per_step: cg_iterations as f64 / steps as f64,
         vbd_iterations_per_step: vbd_iterations as f64 / steps as f64,
         vbd_detections_per_step: vbd_detections as f64 / steps as f64,
+        iterations_per_step: (cg_iterations + vbd_iterations) as f64 / steps as f64,
+        capped_steps,
+        max_residual,
+        from_start,
         wall_per_simulated_s: seconds / (steps as f64 * sim.dt()),
         dt: sim.dt(),
         scene: scene.spec.name.clone(),
@@ -526,8 +557,17 @@ fn scene_steps(
                 )
             } else if vbd_iterations > 0 {
                 format!(
-                    ", {:.1} block-descent iterations and {:.1} detections per step",
-                    figures.vbd_iterations_per_step, figures.vbd_detections_per_step
+                    ", {:.1} block-descent iterations and {:.1} detections per step, {} of \
+                     {steps} steps capped, largest residual {:.3e} of a weight{}",
+                    figures.vbd_iterations_per_step,
+                    figures.vbd_detections_per_step,
+                    figures.capped_steps,
+                    figures.max_residual,
+                    if from_start {
+                        " (timed from the start)"
+                    } else {
+                        ""
+                    }
                 )
             } else {
                 String::new()

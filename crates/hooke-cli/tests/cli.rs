@@ -413,6 +413,56 @@ fn bench_cloth_prints_the_workload_figures_as_json() {
 }
 
 #[test]
+fn bench_scene_times_a_large_step_run_from_its_start_and_says_how_well_it_solved() {
+    let dir = scratch("bench-scene");
+    let json = |args: &[&str]| -> serde_json::Value {
+        let out = hooke(args, &dir);
+        assert!(out.status.success(), "{}", stderr(&out));
+        serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).unwrap()
+    };
+    // Block descent at a display frame, for the scene's whole run: 0.2 s is 12 steps.
+    let mut scene = hooke_scene::builtin::builtin("hanging-cloth").unwrap();
+    scene
+        .set("simulation.duration", toml::Value::Float(0.2))
+        .unwrap();
+    scene
+        .set("simulation.integrator", toml::Value::String("vbd".into()))
+        .unwrap();
+    scene
+        .set("simulation.dt", toml::Value::Float(1.0 / 60.0))
+        .unwrap();
+    std::fs::write(dir.join("short.toml"), hooke_scene::to_toml(&scene)).unwrap();
+    let f = json(&["bench", "scene", "short.toml", "--threads", "2", "--json"]);
+    assert_eq!(f["from_start"], true, "{f}");
+    assert_eq!(f["steps"], 12, "{f}");
+    let iterations = f["iterations_per_step"].as_f64().unwrap();
+    let cap = hooke_core::Integrator::Vbd.iteration_cap().unwrap() as f64;
+    assert!((1.0..=cap).contains(&iterations), "{f}");
+    let capped = f["capped_steps"].as_u64().unwrap();
+    assert!(capped <= 12, "{f}");
+    // Uncapped steps met the stopping rule in fewer sweeps than the cap.
+    if capped == 0 {
+        assert!(iterations < cap, "{f}");
+    }
+    let residual = f["max_residual"].as_f64().unwrap();
+    assert!(residual.is_finite() && residual >= 0.0, "{f}");
+    // An explicit scheme is timed after its warm-up and has no solver to cap.
+    let f = json(&[
+        "bench",
+        "scene",
+        "chain",
+        "--steps",
+        "50",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    assert_eq!(f["from_start"], false, "{f}");
+    assert_eq!(f["capped_steps"], 0, "{f}");
+    assert_eq!(f["max_residual"], 0.0, "{f}");
+}
+
+#[test]
 fn an_obj_export_writes_a_frame_file_per_frame_with_named_objects() {
     let dir = scratch("export-obj");
     let o = hooke(

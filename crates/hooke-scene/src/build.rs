@@ -4,7 +4,7 @@ use crate::colliders::{build_collider, response};
 use crate::error::{BuildError, invalid};
 use crate::generators::Lattice;
 use crate::limits::{
-    MAX_AIR_DENSITY, MAX_PARTICLES, MAX_PENALTY, MAX_STEPS, MAX_WIND, particle_count,
+    DT_RANGE, MAX_AIR_DENSITY, MAX_PARTICLES, MAX_PENALTY, MAX_STEPS, MAX_WIND, particle_count,
 };
 use crate::scene::{Body, ColliderGeometry, Scene, Topology};
 use crate::spec::*;
@@ -20,6 +20,19 @@ impl SceneSpec {
     /// Steps in a full run, from `steps` or `duration / dt` rounded to the nearest step.
     pub fn total_steps(&self) -> Result<u64, BuildError> {
         let sim = &self.simulation;
+        if !DT_RANGE.contains(&sim.dt.get()) {
+            return Err(invalid(
+                "simulation.dt",
+                format!(
+                    "{} s is a step no solver here can represent: its square and inverse \
+                     square leave the numbers' range in the stiffness and inertia terms; \
+                     expected {:e} to {:e} s",
+                    Num(sim.dt.get()),
+                    DT_RANGE.start(),
+                    DT_RANGE.end()
+                ),
+            ));
+        }
         match (sim.steps, sim.duration) {
             (Some(_), Some(_)) => Err(invalid(
                 "simulation",

@@ -35,3 +35,10 @@ pub const MAX_AIR_DENSITY: f64 = 2.0e4;
 /// particle on 1e12 N/m rings at 3e7 rad/s, which asks steps under 1e-7 s, and past it the
 /// penalty energy of a deep contact leaves the range of the numbers.
 pub const MAX_PENALTY: f64 = 1.0e12;
+
+/// The range of step sizes a scene may take, seconds. Every integrator divides by `dt²`
+/// (block descent's inertia `m/dt²`, implicit Euler's `M/dt`, the stable-step estimates),
+/// and the contact and stability figures multiply by it: outside this range those numbers
+/// leave what doubles hold with room to spare, and no scene means such a step (a
+/// femtosecond, or a step of over a quarter of an hour).
+pub const DT_RANGE: std::ops::RangeInclusive<f64> = 1e-15..=1e3;

@@ -68,6 +68,16 @@ impl Integrator {
         }
     }
 
+    /// The most iterations its solver takes in one step (block descent's sweeps, the
+    /// implicit step's conjugate gradients); `None` for the explicit schemes.
+    pub fn iteration_cap(self) -> Option<usize> {
+        match self {
+            Self::Vbd => Some(vbd::MAX_ITERATIONS),
+            Self::Implicit => Some(implicit::CG_MAX_ITERATIONS),
+            _ => None,
+        }
+    }
+
     /// Order of convergence on smooth problems.
     pub fn order(self) -> u32 {
         match self {
@@ -216,6 +226,19 @@ impl Workspace {
     /// Contact detections of the last block-descent step (0 for other integrators).
     pub fn vbd_detections(&self) -> usize {
         self.vbd.detections
+    }
+
+    /// Whether the last step ended at an iteration cap without meeting its solver's
+    /// stopping rule: block descent's iterations, or the implicit step's conjugate gradients
+    /// (`false` for the explicit integrators).
+    pub fn capped(&self) -> bool {
+        self.vbd.capped || self.implicit.iterations >= implicit::CG_MAX_ITERATIONS
+    }
+
+    /// The last block-descent step's residual: the largest force left on a free particle
+    /// over its weight (docs/physics.md §4.1; 0 for other integrators).
+    pub fn vbd_residual(&self) -> f64 {
+        self.vbd.residual
     }
 
     /// Lays out `model`'s springs and sizes the buffers `integrator` uses for `particles`

@@ -195,7 +195,8 @@ fn energy(h: &mut String, files: &mut Pending, r: &Report) -> Result<()> {
     writeln!(
         h,
         "<h2 id=energy>Energy</h2><p>Total energy (kinetic, springs, gravity, penalty) over the \
-         first {} s of each built-in scene with each integrator at the scene's step. The dashed \
+         first {} s of each built-in scene with each integrator, the explicit ones at the \
+         scene's step and the large-step ones (implicit, vbd) at 1/60 s. The dashed \
          black line is what the damping alone would leave for the scene's own integrator: E(0) \
          − ∫ Σ k<sub>d</sub> (Δv·u)² + drag |v|² dt. Where nothing else takes energy (no collider, \
          air or field) midpoint's and RK4's loss must equal it within 1 %; the first-order schemes \

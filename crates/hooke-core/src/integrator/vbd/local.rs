@@ -125,6 +125,41 @@ fn normal_law(d: f64, h: f64, k: f64, n: Vec3) -> (Vec3, f64, f64) {
 impl Local<'_> {
     /// Particle `i`'s position after one Newton step on its local energy, at positions `x`.
     pub(super) fn solve(&self, i: usize, x: &[Vec3]) -> Vec3 {
+        let b = self.block(i, x);
+        let xi = x[i];
+        let inertia = self.mass[i] / (self.dt * self.dt);
+        let step =
+            b.h.inverse()
+                .map(|inv| inv.mul(&b.f))
+                .filter(|s| s.iter().all(|c| c.is_finite()))
+                .unwrap_or(b.f / inertia);
+        // No contact gap closes by more than half in one update: a Newton step on the
+        // barrier overshoots under a large load, and the bound would then only halve the
+        // gap again and again.
+        let scale = b
+            .gaps
+            .iter()
+            .map(|&(d, g)| {
+                let closing = -g.dot(&step);
+                if closing > 0.5 * d {
+                    0.5 * d / closing
+                } else {
+                    1.0
+                }
+            })
+            .fold(1.0, f64::min);
+        xi + step * scale.max(0.0)
+    }
+
+    /// The force left on particle `i` at positions `x`: minus the gradient of the step's
+    /// energy with respect to its position (contacts in their band count no force, as in
+    /// the update). Zero at the solution of the implicit-Euler equations.
+    pub(super) fn force(&self, i: usize, x: &[Vec3]) -> Vec3 {
+        self.block(i, x).f
+    }
+
+    /// Particle `i`'s force and Hessian block at positions `x`.
+    fn block(&self, i: usize, x: &[Vec3]) -> Block {
         let dt = self.dt;
         let inertia = self.mass[i] / (dt * dt);
         let xi = x[i];
@@ -164,27 +199,7 @@ impl Local<'_> {
         }
         self.colliders(i, &xi, moved, &mut b);
         self.pairs(i, x, &mut b);
-        let step =
-            b.h.inverse()
-                .map(|inv| inv.mul(&b.f))
-                .filter(|s| s.iter().all(|c| c.is_finite()))
-                .unwrap_or(b.f / inertia);
-        // No contact gap closes by more than half in one update: a Newton step on the
-        // barrier overshoots under a large load, and the bound would then only halve the
-        // gap again and again.
-        let scale = b
-            .gaps
-            .iter()
-            .map(|&(d, g)| {
-                let closing = -g.dot(&step);
-                if closing > 0.5 * d {
-                    0.5 * d / closing
-                } else {
-                    1.0
-                }
-            })
-            .fold(1.0, f64::min);
-        xi + step * scale.max(0.0)
+        b
     }
 
     fn colliders(&self, i: usize, xi: &Vec3, moved: Vec3, b: &mut Block) {

@@ -66,6 +66,11 @@ pub(crate) struct VbdBuffers {
     /// Iterations and detections of the last step.
     pub(crate) iterations: usize,
     pub(crate) detections: usize,
+    /// Whether the last step ended at [`MAX_ITERATIONS`] without meeting its stopping rule.
+    pub(crate) capped: bool,
+    /// The last step's residual: the largest force left on a free particle at the end of
+    /// the step, over its weight (docs/physics.md §4.1).
+    pub(crate) residual: f64,
 }
 
 pub(super) fn step(
@@ -161,6 +166,7 @@ pub(super) fn step(
     let mut since_detection = 0;
     let start = &ws.x0;
     let mut iterations = 0;
+    let mut converged = false;
     while iterations < MAX_ITERATIONS {
         iterations += 1;
         let mut largest = 0.0_f64;
@@ -204,6 +210,7 @@ pub(super) fn step(
                 .map(|(x, s)| (x - s).norm())
                 .fold(0.0, f64::max);
         if !clipped && largest <= TOLERANCE * scale.max(g * dt * dt) + FLOOR {
+            converged = true;
             break;
         }
         // Chebyshev semi-iterative acceleration (Wang 2015, as Chen et al. 2024 use it),
@@ -236,11 +243,38 @@ pub(super) fn step(
         }
     }
     b.iterations = iterations;
+    b.capped = !converged;
+    b.residual = residual(
+        &Local {
+            model,
+            graph: &b.graph,
+            detection: &b.detection,
+            mass: &p.mass,
+            start,
+            target: &b.target,
+            dt,
+        },
+        p,
+        g,
+    );
     for ((v, x), s) in p.v.iter_mut().zip(&p.x).zip(start) {
         *v = (x - s) / dt;
     }
     keep_momentum(model, p, start, &b.momentum, dt);
     StepReport::SAVED
+}
+
+/// The largest force left on a free particle, over its weight `m a` with `a` gravity's
+/// magnitude `g` (1 m/s² where there is none): the residual of the implicit-Euler
+/// equations at the step's end. A maximum, so the same on any thread count.
+fn residual(local: &Local<'_>, p: &Particles, g: f64) -> f64 {
+    let a = if g > 0.0 { g } else { 1.0 };
+    (0..p.len())
+        .into_par_iter()
+        .with_min_len(CHUNK)
+        .filter(|&i| !p.is_pinned(i))
+        .map(|i| local.force(i, &p.x).norm() / (p.mass[i] * a))
+        .reduce(|| 0.0, f64::max)
 }
 
 /// Springs and contacts between the bodies' own particles are internal forces, so implicit
