@@ -345,3 +345,104 @@ fn three_cloths_dropped_in_a_stack_end_stacked_without_crossing() {
         "layer heights over the centre: {heights:?}"
     );
 }
+
+/// At a frame per step (1/60 s) a 12 × 12 sheet on a 25° incline slides with a block's
+/// acceleration `g (sin θ - μ cos θ)` within 3 % while `tan θ > μ` (frictionless and
+/// μ = 0.2), and stays where it is for μ = 0.6 > tan θ: a half-space collider bounds only
+/// the motion that closes the gap to it, not the sliding (docs/physics.md §4.1).
+#[test]
+fn at_a_frame_per_step_a_sheet_slides_down_an_incline_as_coulomb_says() {
+    let theta = 25.0_f64.to_radians();
+    let h = 0.005;
+    let normal = Vec3::new(-theta.sin(), theta.cos(), 0.0);
+    let downhill = Vec3::new(-theta.cos(), -theta.sin(), 0.0);
+    for mu in [0.0, 0.2, 0.6] {
+        let plane = format!(
+            r#"
+[[collider]]
+[collider.shape]
+kind = "plane"
+coefficients = [{}, {}, 0.0, 0.0]
+[collider.response]
+kind = "restitution"
+cr = 0.0
+friction = {mu}
+"#,
+            normal.x, normal.y
+        );
+        let origin = normal * h + Vec3::new(0.0, 0.0, -0.2);
+        let mut scene = sheet_scene(12, origin.into(), 25.0, &plane, FRAME);
+        let along = |scene: &Scene| {
+            let p = scene.simulation.particles();
+            let c: Vec3 = p.x.iter().sum::<Vec3>() / p.len() as f64;
+            c.dot(&downhill)
+        };
+        let s0 = along(&scene);
+        let mut s = Vec::new();
+        for _ in 0..3 {
+            scene.simulation.advance(15).unwrap();
+            s.push(along(&scene));
+        }
+        let t = 15.0 * FRAME;
+        let a = (s[2] - 2.0 * s[1] + s[0]) / (t * t);
+        let expected = 9.81 * (theta.sin() - mu * theta.cos());
+        eprintln!(
+            "mu {mu}: a = {a} m/s², expected {expected}, moved {} m",
+            s[2] - s0
+        );
+        if expected > 0.0 {
+            assert!(
+                (a / expected - 1.0).abs() < 0.03,
+                "μ = {mu}: acceleration {a} m/s², expected {expected} m/s²"
+            );
+        } else {
+            assert!((s[2] - s0).abs() < 1e-3, "μ = {mu}: moved {} m", s[2] - s0);
+        }
+        let p = scene.simulation.particles();
+        for x in &p.x {
+            let height = x.dot(&normal);
+            assert!(height > 0.5 * h && height < 1.5 * h, "μ = {mu}: {height}");
+        }
+    }
+}
+
+/// At a frame per step a point landing at 1 m/s on frictionless ground keeps its
+/// horizontal speed within 1 % and ends on the ground, not under it: the ground bounds only
+/// the motion into it (docs/physics.md §4.1).
+#[test]
+fn at_a_frame_per_step_a_point_lands_on_frictionless_ground_and_slides_on() {
+    let mut scene = scene_from_text(&format!(
+        r#"
+name = "landing"
+[simulation]
+integrator = "vbd"
+dt = {FRAME}
+duration = 2.0
+every = 1
+gravity = [0.0, -9.81, 0.0]
+[[body]]
+name = "point"
+mass = 0.01
+origin = [0.0, 0.3, 0.0]
+velocity = [1.0, 0.0, 0.0]
+[body.shape]
+kind = "points"
+positions = [[0.0, 0.0, 0.0]]
+[[collider]]
+[collider.shape]
+kind = "ground"
+height = 0.0
+[collider.response]
+kind = "restitution"
+cr = 0.0
+friction = 0.0
+"#
+    ));
+    let steps = scene.steps;
+    scene.simulation.advance(steps).unwrap();
+    let p = scene.simulation.particles();
+    let (x, v) = (p.x[0], p.v[0]);
+    assert!((v.x - 1.0).abs() < 0.01, "horizontal speed {} m/s", v.x);
+    assert!(x.y >= 0.0 && x.y < 1e-3, "height {} m", x.y);
+    assert!((x.x - 2.0).abs() < 0.05, "travelled {} m", x.x);
+}

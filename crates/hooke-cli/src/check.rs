@@ -65,8 +65,9 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
             "vbd does not guarantee: a solved step. It stops after {} iterations whether or \
              not it met its stopping rule; `hooke bench scene` counts such capped steps and \
              the largest residual (force left over weight). Contacts are inelastic (cr has \
-             no effect), and a particle slides along a collider at most about 0.9 of its gap \
-             per detection, so fast sliding at large steps is held back",
+             no effect), and a particle slides along a mesh or cylinder collider at most about \
+             0.9 of its gap per detection (along the ground and planes freely), so fast \
+             sliding over a tabletop at large steps is held back",
             Integrator::Vbd.iteration_cap().unwrap_or_default()
         );
         return Ok(ExitCode::SUCCESS);

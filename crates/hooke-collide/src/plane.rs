@@ -113,6 +113,10 @@ impl Collider for Plane {
         !clear
     }
 
+    fn is_half_space(&self) -> bool {
+        true
+    }
+
     fn contacts_within(&self, p: &Vec3, margin: f64, sink: &mut dyn FnMut(Contact)) {
         if margin == 0.0 {
             return self.contacts(p, sink);

@@ -98,6 +98,14 @@ pub trait Collider: Debug + Send + Sync {
         None
     }
 
+    /// Whether the solid is exactly a half-space: every point on the free side of its
+    /// surface's tangent plane anywhere is outside (an infinite plane). Block descent then
+    /// bounds only the motion that closes a particle's gap to it, not its sliding along it
+    /// (docs/physics.md §4.1). The default, `false`, is always safe.
+    fn is_half_space(&self) -> bool {
+        false
+    }
+
     /// The thinnest extent of the solid in metres, for the tunnelling check: a particle that
     /// moves more than half of it in one step can end nearer the far side and be pushed out
     /// there. `None` for half-spaces and for open sheets (which the crossing test guards).

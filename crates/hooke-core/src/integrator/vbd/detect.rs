@@ -19,7 +19,7 @@
 
 use super::graph::Graph;
 use super::pairs::{Pair, Sides, feature_triangle, stencil_distance};
-use super::planes::{Plane, Touches};
+use super::planes::{HalfSpaces, Plane, Touches};
 use crate::collider::response::Response;
 use crate::contact::grid::{Cell, Grid};
 use crate::contact::proximity::{point_triangle, segment_segment};
@@ -157,6 +157,9 @@ pub(super) struct Detection {
     /// Per particle: the collider surfaces it may reach before the next detection, each as
     /// its tangent plane at the detection.
     pub(super) touches: Vec<Touches>,
+    /// Per particle: the half-space colliders near it, which bound only the motion that
+    /// closes its gap to them.
+    pub(super) halves: Vec<HalfSpaces>,
     /// Surface pairs and feature pairs within reach.
     pub(super) pairs: Vec<Pair>,
     /// Particle `i`'s pairs are `refs[start[i]..start[i + 1]]`.
@@ -353,22 +356,27 @@ impl Detection {
         let n = x.len();
         self.point_collider.resize(n, Clearance::new(reach));
         self.touches.resize(n, Touches::default());
-        let one = |i: usize, clearance: &mut Clearance, near: &mut Touches| {
+        self.halves.resize(n, HalfSpaces::default());
+        let one = |i: usize, (clearance, near, halves): (&mut Clearance, &mut Touches, &mut HalfSpaces)| {
             let margin = topology.margin(model, i);
             let (lo, hi) = (x[i].add_scalar(-reach), x[i].add_scalar(reach));
             *clearance = Clearance::new(reach);
             *near = Touches::default();
+            *halves = HalfSpaces::default();
             for (k, slot) in model.colliders.iter().enumerate() {
                 if !slot.shape.may_touch(&lo, &hi, 0.0) {
                     continue;
                 }
+                let half = slot.shape.is_half_space();
                 slot.shape.contacts_within(&x[i], reach, &mut |c| {
                     let d = reach - c.depth;
                     // Inside already: no bound from it (staying is no crossing); its
                     // contact pushes the particle out.
                     let inside = d < 0.0;
                     let felt = inside || d <= FELT * margin;
-                    if !inside {
+                    // A half-space bounds only the motion along its normal.
+                    let kept = half && !inside && halves.keep(c.point, c.normal, d);
+                    if !inside && !kept {
                         clearance.see(d, felt);
                     }
                     if felt {
@@ -382,19 +390,24 @@ impl Detection {
                 });
             }
         };
-        let (clearances, near) = (&mut self.point_collider, &mut self.touches);
+        let (clearances, near, halves) = (
+            &mut self.point_collider,
+            &mut self.touches,
+            &mut self.halves,
+        );
         if n <= CHUNK {
             for i in 0..n {
-                one(i, &mut clearances[i], &mut near[i]);
+                one(i, (&mut clearances[i], &mut near[i], &mut halves[i]));
             }
         } else {
             clearances
                 .par_chunks_mut(CHUNK)
                 .zip(near.par_chunks_mut(CHUNK))
+                .zip(halves.par_chunks_mut(CHUNK))
                 .enumerate()
-                .for_each(|(c, (cl, ne))| {
+                .for_each(|(c, ((cl, ne), ha))| {
                     for k in 0..cl.len() {
-                        one(c * CHUNK + k, &mut cl[k], &mut ne[k]);
+                        one(c * CHUNK + k, (&mut cl[k], &mut ne[k], &mut ha[k]));
                     }
                 });
         }
@@ -691,7 +704,24 @@ impl Detection {
         } else {
             sum / mass
         };
-        if u.norm() > 0.5 * room {
+        // Nor may it close more than half of what a half-space allows a shifted particle:
+        // the ball's centre keeps every half-space bound (docs/physics.md §4.1). A sheet
+        // lying on a plane shifts along it: the part of `u` into a plane it would close
+        // too far is taken out (in particle order), so it slides as a whole.
+        for i in (0..n).filter(|&i| self.shifted[i]) {
+            for &(_, normal, d) in self.halves[i].iter() {
+                let into = -normal.dot(&u);
+                if into > 0.5 * GAMMA_COLLIDER * d {
+                    u += normal * into;
+                }
+            }
+        }
+        let closes_half = (0..n).filter(|&i| self.shifted[i]).any(|i| {
+            self.halves[i]
+                .iter()
+                .any(|&(_, normal, d)| -normal.dot(&u) > 0.5 * GAMMA_COLLIDER * d)
+        });
+        if u.norm() > 0.5 * room || closes_half {
             u = Vec3::zeros();
         }
         self.shift = u;

@@ -28,6 +28,12 @@ pub(super) struct Graph {
     pub(super) stiffness: Vec<f64>,
     /// Whether the colouring also separates the last detection's contact pairs.
     pub(super) coloured_with_contacts: bool,
+    /// The bodies that may translate as a whole: the particles of each connected set of
+    /// springs holding no pinned particle, in increasing index (the coarse correction's
+    /// groups, docs/physics.md §4.1).
+    pub(super) free_bodies: Vec<Vec<u32>>,
+    /// Per particle: the index of its free body, or `u32::MAX`.
+    pub(super) body_of: Vec<u32>,
 }
 
 impl Graph {
@@ -78,7 +84,15 @@ impl Graph {
             colours: Vec::new(),
             stiffness,
             coloured_with_contacts: false,
+            free_bodies: Vec::new(),
+            body_of: vec![u32::MAX; n],
         };
+        graph.free_bodies = free_bodies(model, p);
+        for (b, body) in graph.free_bodies.iter().enumerate() {
+            for &i in body {
+                graph.body_of[i as usize] = b as u32;
+            }
+        }
         graph.colour(p, |_, _| {});
         graph
     }
@@ -128,6 +142,41 @@ impl Graph {
     pub(super) fn of(&self, i: usize) -> &[Neighbour] {
         &self.neighbours[self.start[i] as usize..self.start[i + 1] as usize]
     }
+}
+
+/// The particles of each connected set of springs with no pinned particle (and more than one
+/// particle), each in increasing index, the sets ordered by their lowest index: a function
+/// of the model alone.
+fn free_bodies(model: &Model, p: &Particles) -> Vec<Vec<u32>> {
+    let n = p.len();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn root(parent: &mut [u32], mut i: u32) -> u32 {
+        while parent[i as usize] != i {
+            let up = parent[parent[i as usize] as usize];
+            parent[i as usize] = up;
+            i = up;
+        }
+        i
+    }
+    for s in &model.springs {
+        let (a, b) = (root(&mut parent, s.i), root(&mut parent, s.j));
+        // The lower index is the root: the result does not depend on the spring order.
+        let (lo, hi) = (a.min(b), a.max(b));
+        parent[hi as usize] = lo;
+    }
+    let mut members: Vec<Vec<u32>> = vec![Vec::new(); n];
+    let mut held = vec![false; n];
+    for i in 0..n {
+        let r = root(&mut parent, i as u32) as usize;
+        members[r].push(i as u32);
+        held[r] |= p.is_pinned(i);
+    }
+    members
+        .into_iter()
+        .enumerate()
+        .filter(|(r, m)| m.len() > 1 && !held[*r])
+        .map(|(_, m)| m)
+        .collect()
 }
 
 #[cfg(test)]

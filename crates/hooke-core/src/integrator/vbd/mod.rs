@@ -9,7 +9,12 @@
 //! * Iterations visit the particles colour by colour (no spring inside a colour); each takes
 //!   one 3×3 Newton step on its own energy, others fixed. Within a colour every update reads
 //!   the positions the colour started with, so the result is the same on any thread count.
-//! * Every update is clipped to its particle's ball from the last detection (`detect.rs`);
+//! * After the colours, each free body moves as a whole by the Newton step of its
+//!   translation (the coarse correction), which Gauss–Seidel alone takes hundreds of
+//!   sweeps to make on a stiff sheet.
+//! * Every update is clipped to its particle's ball from the last detection (`detect.rs`),
+//!   and kept on the free side of the half-space colliders near it (bounding only the
+//!   motion into them, so particles slide along planes);
 //!   an iteration that clipped any particle ends with a new detection.
 //! * The step stops when an iteration moves no particle more than [`TOLERANCE`] of the
 //!   step's largest displacement (and clipped none), or after [`MAX_ITERATIONS`]. Then
@@ -22,6 +27,7 @@ mod pairs;
 mod planes;
 
 use super::{StepReport, Workspace};
+use crate::integrator::Sym3;
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
 use detect::Detection;
@@ -63,6 +69,8 @@ pub(crate) struct VbdBuffers {
     /// The last two iterates (for the acceleration).
     old: Vec<Vec3>,
     older: Vec<Vec3>,
+    /// Per chunk of a body: its particles' forces and translation stiffness, summed.
+    parts: Vec<(Vec3, Sym3)>,
     /// Iterations and detections of the last step.
     pub(crate) iterations: usize,
     pub(crate) detections: usize,
@@ -204,6 +212,18 @@ pub(super) fn step(
                 p.x[i] = xi;
             }
         }
+        let local = Local {
+            model,
+            graph: &b.graph,
+            detection: &b.detection,
+            mass: &p.mass,
+            start,
+            target: &b.target,
+            dt,
+        };
+        let (moved, c) = translate_bodies(&local, &b.detected, &mut b.parts, &mut p.x);
+        largest = largest.max(moved);
+        clipped |= c;
         let scale =
             p.x.iter()
                 .zip(start)
@@ -262,6 +282,77 @@ pub(super) fn step(
     }
     keep_momentum(model, p, start, &b.momentum, dt);
     StepReport::SAVED
+}
+
+/// The coarse correction (a two-level scheme's coarsest level, after Tamstorf et al. 2015):
+/// each free body moves as a whole by the Newton step of its translation, `Δ = H⁻¹ F`
+/// with `F` the sum of its particles' forces and `H` of their Hessians less the springs'
+/// (which cancel for a translation), every particle clipped to its bounds. Gauss–Seidel
+/// moves a stiff sheet as a whole by about `m/dt² / Σ ks` of the way per sweep; this moves
+/// it all the way in one. Sums in fixed chunks, in order: the same bits on any thread count.
+/// Returns the largest move and whether any particle was clipped.
+fn translate_bodies(
+    local: &Local<'_>,
+    detected: &[Vec3],
+    parts: &mut Vec<(Vec3, Sym3)>,
+    x: &mut [Vec3],
+) -> (f64, bool) {
+    let (mut largest, mut clipped) = (0.0f64, false);
+    let graph = local.graph;
+    for (k, body) in graph.free_bodies.iter().enumerate() {
+        // A body touching another moves with it in its contacts: corrected alone, each
+        // would push the other back and forth (a stack jitters). Those keep the sweeps.
+        let touches_another = body.iter().any(|&i| {
+            local.detection.pairs_of(i as usize).any(|pair| {
+                // A feature pair's other side is a collider, not a body.
+                !matches!(pair.sides, pairs::Sides::Feature(_))
+                    && pair
+                        .ids
+                        .iter()
+                        .any(|&j| graph.body_of[j as usize] != k as u32)
+            })
+        });
+        if touches_another {
+            continue;
+        }
+        let chunks = body.len().div_ceil(CHUNK);
+        parts.clear();
+        parts.resize(chunks, (Vec3::zeros(), Sym3::default()));
+        let sum = |ids: &[u32], out: &mut (Vec3, Sym3)| {
+            for &i in ids {
+                let (f, h) = local.translation(i as usize, x);
+                out.0 += f;
+                out.1 = out.1.plus(&h);
+            }
+        };
+        if chunks == 1 {
+            sum(body, &mut parts[0]);
+        } else {
+            body.par_chunks(CHUNK)
+                .zip(parts.par_iter_mut())
+                .for_each(|(ids, out)| sum(ids, out));
+        }
+        let (f, h) = parts
+            .iter()
+            .fold((Vec3::zeros(), Sym3::default()), |(f, h), (pf, ph)| {
+                (f + pf, h.plus(ph))
+            });
+        let Some(d) = h
+            .inverse()
+            .map(|inv| inv.mul(&f))
+            .filter(|d| d.iter().all(|c| c.is_finite()))
+        else {
+            continue;
+        };
+        for &i in body {
+            let i = i as usize;
+            let (to, c) = clip(local.detection, detected, i, x[i] + d);
+            largest = largest.max((to - x[i]).norm());
+            clipped |= c;
+            x[i] = to;
+        }
+    }
+    (largest, clipped)
 }
 
 /// The largest force left on a free particle, over its weight `m a` with `a` gravity's
@@ -327,9 +418,40 @@ fn clip(detection: &Detection, detected: &[Vec3], i: usize, to: Vec3) -> (Vec3, 
     let r = detection.bound[i];
     let off = to - centre;
     let len = off.norm();
-    if len <= r {
+    let (mut x, mut clipped) = if len <= r {
         (to, false)
     } else {
         (centre + off * (r / len), true)
+    };
+    // Each half-space keeps `(1 - γ)` of the particle's gap to it. A point that goes too
+    // deep is lifted back along the plane's normal, keeping its sliding, when that stays in
+    // the ball and keeps every half-space; otherwise it is taken back along the segment
+    // from the centre, which keeps them all.
+    let halves = &detection.halves[i];
+    let floor = |d: f64| (1.0 - detect::GAMMA_COLLIDER) * d;
+    let depth =
+        |y: &Vec3, &(point, normal, d): &(Vec3, Vec3, f64)| floor(d) - normal.dot(&(y - point));
+    if halves.iter().any(|h| depth(&x, h) > 0.0) {
+        clipped = true;
+        let mut lifted = x;
+        for h in halves.iter() {
+            lifted += h.1 * depth(&lifted, h).max(0.0);
+        }
+        if (lifted - centre).norm() <= r && halves.iter().all(|h| depth(&lifted, h) <= 0.0) {
+            x = lifted;
+        } else {
+            for h in halves.iter() {
+                let (below, from) = (depth(&x, h), depth(&centre, h));
+                if below > 0.0 {
+                    let t = if below > from {
+                        (-from / (below - from)).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    };
+                    x = centre + (x - centre) * t;
+                }
+            }
+        }
     }
+    (x, clipped)
 }

@@ -68,3 +68,34 @@ impl Touches {
         self.gaps[k] = d;
     }
 }
+
+/// Half-space colliders a particle keeps at most (ground and an inclined plane); further
+/// ones bound it with its ball, as any collider does.
+const HALF_SPACES: usize = 2;
+
+/// The half-space colliders (infinite planes) near one particle at the last detection, with
+/// its gap to each. Between detections the particle may move anywhere that keeps
+/// `normal · (x - point)` above `(1 - γ)` of that gap: sliding along a plane closes no gap,
+/// so only the motion along its normal is bounded (docs/physics.md §4.1).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct HalfSpaces {
+    count: u8,
+    planes: [(Vec3, Vec3, f64); HALF_SPACES],
+}
+
+impl HalfSpaces {
+    /// Keeps the plane through `point` with unit `normal` at gap `d`; `false` when full.
+    pub(super) fn keep(&mut self, point: Vec3, normal: Vec3, d: f64) -> bool {
+        if self.count as usize == HALF_SPACES {
+            return false;
+        }
+        self.planes[self.count as usize] = (point, normal, d);
+        self.count += 1;
+        true
+    }
+
+    /// `(point, normal, gap)` of each plane kept.
+    pub(super) fn iter(&self) -> impl Iterator<Item = &(Vec3, Vec3, f64)> {
+        self.planes[..self.count as usize].iter()
+    }
+}
