@@ -156,6 +156,42 @@ kd = 0.005
     ))
 }
 
+/// A frictionless-restitution plane through the origin with unit `normal` (in the x-y plane)
+/// and Coulomb coefficient `mu`, as a scene's collider table.
+fn incline(normal: &Vec3, mu: f64) -> String {
+    format!(
+        r#"
+[[collider]]
+[collider.shape]
+kind = "plane"
+coefficients = [{}, {}, 0.0, 0.0]
+[collider.response]
+kind = "restitution"
+cr = 0.0
+friction = {mu}
+"#,
+        normal.x, normal.y
+    )
+}
+
+/// How far the sheet's centroid moves along `downhill` over three runs of `steps` steps,
+/// and its acceleration from the three positions' second difference.
+fn slide(scene: &mut Scene, downhill: &Vec3, steps: u64) -> (f64, f64) {
+    let along = |scene: &Scene| {
+        let p = scene.simulation.particles();
+        let c: Vec3 = p.x.iter().sum::<Vec3>() / p.len() as f64;
+        c.dot(downhill)
+    };
+    let start = along(scene);
+    let mut s = Vec::new();
+    for _ in 0..3 {
+        scene.simulation.advance(steps).unwrap();
+        s.push(along(scene));
+    }
+    let t = steps as f64 * scene.simulation.dt();
+    (s[2] - start, (s[2] - 2.0 * s[1] + s[0]) / (t * t))
+}
+
 /// A sheet laid a thickness above the ground holds that height at a frame per step: every
 /// particle stays between the thickness less a tenth and the thickness plus its contact
 /// band, and nothing moves.
@@ -195,35 +231,12 @@ fn a_sheet_sliding_on_an_incline_accelerates_at_g_sin_minus_mu_cos() {
     let (theta, mu, h) = (30.0_f64.to_radians(), 0.3, 0.005);
     let normal = Vec3::new(-theta.sin(), theta.cos(), 0.0);
     let downhill = Vec3::new(-theta.cos(), -theta.sin(), 0.0);
-    let plane = format!(
-        r#"
-[[collider]]
-[collider.shape]
-kind = "plane"
-coefficients = [{}, {}, 0.0, 0.0]
-[collider.response]
-kind = "restitution"
-cr = 0.0
-friction = {mu}
-"#,
-        normal.x, normal.y
-    );
+    let plane = incline(&normal, mu);
     let origin = normal * h + Vec3::new(0.0, 0.0, -0.2);
     let dt = FRAME / 16.0;
     let mut scene = sheet_scene(6, origin.into(), 30.0, &plane, dt);
-    let along = |scene: &Scene| {
-        let p = scene.simulation.particles();
-        let c: Vec3 = p.x.iter().sum::<Vec3>() / p.len() as f64;
-        c.dot(&downhill)
-    };
     // Sliding starts at once; positions at 0.25, 0.5 and 0.75 s.
-    let mut s = Vec::new();
-    for _ in 0..3 {
-        scene.simulation.advance(240).unwrap();
-        s.push(along(&scene));
-    }
-    let t = 240.0 * dt;
-    let a = (s[2] - 2.0 * s[1] + s[0]) / (t * t);
+    let (_, a) = slide(&mut scene, &downhill, 240);
     let expected = 9.81 * (theta.sin() - mu * theta.cos());
     assert!(
         (a / expected - 1.0).abs() < 0.01,
@@ -357,46 +370,18 @@ fn at_a_frame_per_step_a_sheet_slides_down_an_incline_as_coulomb_says() {
     let normal = Vec3::new(-theta.sin(), theta.cos(), 0.0);
     let downhill = Vec3::new(-theta.cos(), -theta.sin(), 0.0);
     for mu in [0.0, 0.2, 0.6] {
-        let plane = format!(
-            r#"
-[[collider]]
-[collider.shape]
-kind = "plane"
-coefficients = [{}, {}, 0.0, 0.0]
-[collider.response]
-kind = "restitution"
-cr = 0.0
-friction = {mu}
-"#,
-            normal.x, normal.y
-        );
+        let plane = incline(&normal, mu);
         let origin = normal * h + Vec3::new(0.0, 0.0, -0.2);
         let mut scene = sheet_scene(12, origin.into(), 25.0, &plane, FRAME);
-        let along = |scene: &Scene| {
-            let p = scene.simulation.particles();
-            let c: Vec3 = p.x.iter().sum::<Vec3>() / p.len() as f64;
-            c.dot(&downhill)
-        };
-        let s0 = along(&scene);
-        let mut s = Vec::new();
-        for _ in 0..3 {
-            scene.simulation.advance(15).unwrap();
-            s.push(along(&scene));
-        }
-        let t = 15.0 * FRAME;
-        let a = (s[2] - 2.0 * s[1] + s[0]) / (t * t);
+        let (moved, a) = slide(&mut scene, &downhill, 15);
         let expected = 9.81 * (theta.sin() - mu * theta.cos());
-        eprintln!(
-            "mu {mu}: a = {a} m/s², expected {expected}, moved {} m",
-            s[2] - s0
-        );
         if expected > 0.0 {
             assert!(
                 (a / expected - 1.0).abs() < 0.03,
                 "μ = {mu}: acceleration {a} m/s², expected {expected} m/s²"
             );
         } else {
-            assert!((s[2] - s0).abs() < 1e-3, "μ = {mu}: moved {} m", s[2] - s0);
+            assert!(moved.abs() < 1e-3, "μ = {mu}: moved {moved} m");
         }
         let p = scene.simulation.particles();
         for x in &p.x {

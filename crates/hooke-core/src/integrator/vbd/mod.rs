@@ -179,16 +179,16 @@ pub(super) fn step(
         iterations += 1;
         let mut largest = 0.0_f64;
         let mut clipped = false;
+        let local = Local {
+            model,
+            graph: &b.graph,
+            detection: &b.detection,
+            mass: &p.mass,
+            start,
+            target: &b.target,
+            dt,
+        };
         for colour in &b.graph.colours {
-            let local = Local {
-                model,
-                graph: &b.graph,
-                detection: &b.detection,
-                mass: &p.mass,
-                start,
-                target: &b.target,
-                dt,
-            };
             let (x, detected, detection) = (&p.x, &b.detected, &b.detection);
             b.next.resize(colour.len(), (Vec3::zeros(), false));
             let update = |ids: &[u32], out: &mut [(Vec3, bool)]| {
@@ -212,15 +212,6 @@ pub(super) fn step(
                 p.x[i] = xi;
             }
         }
-        let local = Local {
-            model,
-            graph: &b.graph,
-            detection: &b.detection,
-            mass: &p.mass,
-            start,
-            target: &b.target,
-            dt,
-        };
         let (moved, c) = translate_bodies(&local, &b.detected, &mut b.parts, &mut p.x);
         largest = largest.max(moved);
         clipped |= c;
