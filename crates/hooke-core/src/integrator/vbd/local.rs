@@ -37,9 +37,6 @@ pub(super) struct Local<'a> {
 struct Block {
     f: Vec3,
     h: Sym3,
-    /// The part of `h` that is not the springs': what resists moving the particle with its
-    /// whole body (inertia, drag, attachments, contacts).
-    own: Sym3,
     gaps: Gaps,
 }
 
@@ -85,7 +82,7 @@ impl Block {
         dt: f64,
     ) {
         let nn = Sym3::outer(&n);
-        self.add(&nn.scale(k * w * w));
+        self.h = self.h.plus(&nn.scale(k * w * w));
         if let Some(d) = gap {
             self.gaps.push((d, n * w));
         }
@@ -105,13 +102,7 @@ impl Block {
             mu * lambda / slide.norm().max(STATIC_SPEED * dt)
         };
         self.f -= slide * (c * w);
-        self.add(&tangent.scale(c * w * w));
-    }
-
-    /// Adds a term that is not a spring's to the Hessian.
-    fn add(&mut self, term: &Sym3) {
-        self.h = self.h.plus(term);
-        self.own = self.own.plus(term);
+        self.h = self.h.plus(&tangent.scale(c * w * w));
     }
 }
 
@@ -167,16 +158,22 @@ impl Local<'_> {
         self.block(i, x).f
     }
 
-    /// The force left on particle `i` at positions `x`, and its Hessian block less the
-    /// springs' part: what the particle adds to its body's translation (the springs' forces
-    /// and stiffness cancel over a body moved as a whole).
+    /// What particle `i` adds to its body's translation at positions `x`: its force and
+    /// Hessian block without the springs' terms, which cancel over a body moved as a whole
+    /// (and so are not computed).
     pub(super) fn translation(&self, i: usize, x: &[Vec3]) -> (Vec3, Sym3) {
-        let b = self.block(i, x);
-        (b.f, b.own)
+        let b = self.terms(i, x, false);
+        (b.f, b.h)
     }
 
     /// Particle `i`'s force and Hessian block at positions `x`.
     fn block(&self, i: usize, x: &[Vec3]) -> Block {
+        self.terms(i, x, true)
+    }
+
+    /// Particle `i`'s force and Hessian block at positions `x`, its springs' terms with
+    /// `springs`.
+    fn terms(&self, i: usize, x: &[Vec3], springs: bool) -> Block {
         let dt = self.dt;
         let inertia = self.mass[i] / (dt * dt);
         let xi = x[i];
@@ -184,15 +181,15 @@ impl Local<'_> {
         let mut b = Block {
             f: (self.target[i] - xi) * inertia,
             h: Sym3::default().plus_identity(inertia),
-            own: Sym3::default().plus_identity(inertia),
             gaps: Gaps::default(),
         };
         let model = self.model;
         if model.drag != 0.0 {
             b.f -= moved * (model.drag / dt);
-            b.add(&Sym3::default().plus_identity(model.drag / dt));
+            b.h = b.h.plus_identity(model.drag / dt);
         }
-        for nb in self.graph.of(i) {
+        let mine = if springs { self.graph.of(i) } else { &[] };
+        for nb in mine {
             let j = nb.other as usize;
             let d = xi - x[j];
             let len = d.norm();
@@ -213,7 +210,7 @@ impl Local<'_> {
         }
         for a in model.attachments.iter().filter(|a| a.particle == i) {
             b.f -= (xi - a.target) * a.ks + moved * (a.kd / dt);
-            b.add(&Sym3::default().plus_identity(a.ks + a.kd / dt));
+            b.h = b.h.plus_identity(a.ks + a.kd / dt);
         }
         self.colliders(i, &xi, moved, &mut b);
         self.pairs(i, x, &mut b);
@@ -240,7 +237,7 @@ impl Local<'_> {
                         continue;
                     }
                     b.f += n * (kc * depth - dc * moved.dot(&n) / dt);
-                    b.add(&Sym3::outer(&n).scale(kc + dc / dt));
+                    b.h = b.h.plus(&Sym3::outer(&n).scale(kc + dc / dt));
                 }
                 ref response => {
                     let (k, mu) = collider_law(response, self.detection.scale[i]);

@@ -277,8 +277,8 @@ pub(super) fn step(
 
 /// The coarse correction (a two-level scheme's coarsest level, after Tamstorf et al. 2015):
 /// each free body moves as a whole by the Newton step of its translation, `Δ = H⁻¹ F`
-/// with `F` the sum of its particles' forces and `H` of their Hessians less the springs'
-/// (which cancel for a translation), every particle clipped to its bounds. Gauss–Seidel
+/// with `F` the sum of its particles' forces and `H` of their Hessians, both without the
+/// springs' terms (which cancel for a translation), every particle clipped to its bounds. Gauss–Seidel
 /// moves a stiff sheet as a whole by about `m/dt² / Σ ks` of the way per sweep; this moves
 /// it all the way in one. Sums in fixed chunks, in order: the same bits on any thread count.
 /// Returns the largest move and whether any particle was clipped.
