@@ -224,8 +224,7 @@ friction = 0.5
 
 /// A sheet on a 30° incline with Coulomb friction μ = 0.3 slides with the acceleration of
 /// a block, `g (sin θ - μ cos θ)` = 2.357 m/s², within 1 %, at 16 steps per 60 Hz frame.
-/// (At larger steps the iterations stop before a sheet sliding as a whole has converged:
-/// it slides, slower; docs/physics.md §4.1 gives the figures.)
+/// (At a frame per step, see `at_a_frame_per_step_a_sheet_slides_down_an_incline_as_coulomb_says`.)
 #[test]
 fn a_sheet_sliding_on_an_incline_accelerates_at_g_sin_minus_mu_cos() {
     let (theta, mu, h) = (30.0_f64.to_radians(), 0.3, 0.005);
