@@ -161,29 +161,9 @@ fn damping_rate(model: &Model, p: &Particles) -> f64 {
         row[s.i as usize] += 2.0 * s.kd;
         row[s.j as usize] += 2.0 * s.kd;
     }
-    if let Some(air) = &model.air {
-        // The strongest wind the air blows, and each triangle's relative speed at it: a
-        // triangle's force `½ ρ A C |u| u` changes by at most `ρ A (C_d + C_l) |u|` per unit
-        // of its mean velocity, a corner moves that mean by a third and takes a third of it.
-        let wind = air.wind.norm() + air.gust.map_or(0.0, |g| g.amplitude.norm());
-        for surface in &model.aero {
-            for t in &surface.triangles {
-                let [a, b, c] = t.map(|i| i as usize);
-                if c >= n || a >= n || b >= n {
-                    continue;
-                }
-                let area = 0.5 * (p.x[b] - p.x[a]).cross(&(p.x[c] - p.x[a])).norm();
-                let mean = (p.v[a] + p.v[b] + p.v[c]) * (1.0 / 3.0);
-                let speed = mean.norm() + wind;
-                let k = air.density * area * (surface.drag.abs() + surface.lift.abs()) * speed;
-                if k.is_finite() {
-                    for i in [a, b, c] {
-                        row[i] += k / 3.0;
-                    }
-                }
-            }
-        }
-    }
+    // A triangle's force `½ ρ A C |u| u` changes by at most `ρ A C |u|` per unit of its
+    // mean velocity; a corner moves that mean by a third and takes a third of it.
+    add_air(model, p, &mut row, |t| t.rho_c * t.area * t.speed / 3.0);
     row.iter()
         .zip(&p.mass)
         .zip(&p.inv_mass)
@@ -201,35 +181,52 @@ fn damping_rate(model: &Model, p: &Particles) -> f64 {
 fn diagonal_stiffness(model: &Model, p: &Particles, penalty_k: f64) -> Vec<f64> {
     let n = p.len();
     let mut row = vec![penalty_k; n];
-    if let Some(air) = &model.air {
-        let wind = air.wind.norm() + air.gust.map_or(0.0, |g| g.amplitude.norm());
-        for surface in &model.aero {
-            for t in &surface.triangles {
-                let [a, b, c] = t.map(|i| i as usize);
-                if a >= n || b >= n || c >= n {
-                    continue;
-                }
-                let longest = (p.x[b] - p.x[a])
-                    .norm()
-                    .max((p.x[c] - p.x[b]).norm())
-                    .max((p.x[a] - p.x[c]).norm());
-                let mean = (p.v[a] + p.v[b] + p.v[c]) * (1.0 / 3.0);
-                let speed = mean.norm() + wind;
-                let k = 0.5
-                    * air.density
-                    * (surface.drag.abs() + surface.lift.abs())
-                    * speed
-                    * speed
-                    * longest;
-                if k.is_finite() {
-                    for i in [a, b, c] {
-                        row[i] += k;
-                    }
+    add_air(model, p, &mut row, |t| {
+        0.5 * t.rho_c * t.speed * t.speed * t.longest
+    });
+    row
+}
+
+/// One aero triangle as the air's row sums see it.
+struct AirTriangle {
+    /// `ρ (|C_d| + |C_l|)`, kg/m³.
+    rho_c: f64,
+    /// Its mean speed plus the strongest wind the air blows, m/s.
+    speed: f64,
+    /// Its area, m², and longest edge, m.
+    area: f64,
+    longest: f64,
+}
+
+/// Adds `term` of each aero triangle (where finite) to each of its corners' rows; nothing
+/// without air.
+fn add_air(model: &Model, p: &Particles, row: &mut [f64], term: impl Fn(&AirTriangle) -> f64) {
+    let Some(air) = &model.air else {
+        return;
+    };
+    let n = p.len();
+    let wind = air.wind.norm() + air.gust.map_or(0.0, |g| g.amplitude.norm());
+    for surface in &model.aero {
+        for t in &surface.triangles {
+            let [a, b, c] = t.map(|i| i as usize);
+            if a >= n || b >= n || c >= n {
+                continue;
+            }
+            let (ab, bc, ca) = (p.x[b] - p.x[a], p.x[c] - p.x[b], p.x[a] - p.x[c]);
+            let mean = (p.v[a] + p.v[b] + p.v[c]) * (1.0 / 3.0);
+            let k = term(&AirTriangle {
+                rho_c: air.density * (surface.drag.abs() + surface.lift.abs()),
+                speed: mean.norm() + wind,
+                area: 0.5 * ab.cross(&(p.x[c] - p.x[a])).norm(),
+                longest: ab.norm().max(bc.norm()).max(ca.norm()),
+            });
+            if k.is_finite() {
+                for i in [a, b, c] {
+                    row[i] += k;
                 }
             }
         }
     }
-    row
 }
 
 /// The penalty colliders' stiffness, summed: the most a particle touching all of them feels.
