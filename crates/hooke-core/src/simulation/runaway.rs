@@ -26,9 +26,10 @@
 use crate::forces::air::AirForces;
 use crate::integrator::Integrator;
 use crate::model::Model;
-use crate::particles::{Particles, Vec3};
+use crate::particles::Particles;
 use crate::simulation::divergence::Divergence;
 use crate::simulation::stability::StabilityEstimate;
+use crate::simulation::summary;
 
 /// Simulated time between checks, seconds.
 const CHECK_EVERY: f64 = 0.01;
@@ -55,14 +56,7 @@ pub(crate) struct EnergyWatch {
 
 /// The total energy of a state: kinetic plus potential.
 fn energy(model: &Model, p: &Particles) -> f64 {
-    let kinetic: f64 =
-        p.v.iter()
-            .zip(&p.mass)
-            .zip(&p.inv_mass)
-            .filter(|(_, inv)| **inv != 0.0)
-            .map(|((v, m), _)| 0.5 * m * v.norm_squared())
-            .sum();
-    kinetic + model.potential_energy(&p.mass, &p.x)
+    summary::kinetic(p) + model.potential_energy(&p.mass, &p.x)
 }
 
 impl EnergyWatch {
@@ -75,10 +69,7 @@ impl EnergyWatch {
                 .zip(&p.mass)
                 .map(|(x, m)| -m * model.gravity.dot(x))
                 .sum();
-        let inf = Vec3::repeat(f64::INFINITY);
-        let (lo, hi) =
-            p.x.iter()
-                .fold((inf, -inf), |(lo, hi), x| (lo.inf(x), hi.sup(x)));
+        let (lo, hi) = summary::bounds(&p.x);
         let extent = if p.is_empty() { 0.0 } else { (hi - lo).norm() };
         let free_mass: f64 = p
             .mass

@@ -23,21 +23,9 @@ pub struct Summary {
 impl Summary {
     /// Computes the summary of `particles` under `model`.
     pub fn of(model: &Model, particles: &Particles) -> Self {
-        let kinetic = particles
-            .v
-            .iter()
-            .zip(&particles.mass)
-            .zip(&particles.inv_mass)
-            .filter(|(_, inv)| **inv != 0.0)
-            .map(|((v, m), _)| 0.5 * m * v.norm_squared())
-            .sum();
-        let inf = Vec3::repeat(f64::INFINITY);
-        let (min, max) = particles
-            .x
-            .iter()
-            .fold((inf, -inf), |(lo, hi), x| (lo.inf(x), hi.sup(x)));
+        let (min, max) = bounds(&particles.x);
         Self {
-            kinetic,
+            kinetic: kinetic(particles),
             potential: model.potential_energy(&particles.mass, &particles.x),
             min,
             max,
@@ -45,4 +33,21 @@ impl Summary {
             max_penetration: model.max_penetration(&particles.x),
         }
     }
+}
+
+/// Kinetic energy `Σ m v² / 2` of the free particles, joules.
+pub(crate) fn kinetic(p: &Particles) -> f64 {
+    p.v.iter()
+        .zip(&p.mass)
+        .zip(&p.inv_mass)
+        .filter(|(_, inv)| **inv != 0.0)
+        .map(|((v, m), _)| 0.5 * m * v.norm_squared())
+        .sum()
+}
+
+/// The lower and upper corners of the points' bounding box (infinite ones for none).
+pub(crate) fn bounds(x: &[Vec3]) -> (Vec3, Vec3) {
+    let inf = Vec3::repeat(f64::INFINITY);
+    x.iter()
+        .fold((inf, -inf), |(lo, hi), x| (lo.inf(x), hi.sup(x)))
 }

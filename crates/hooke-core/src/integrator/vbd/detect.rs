@@ -162,6 +162,9 @@ pub(super) struct Detection {
     pub(super) halves: Vec<HalfSpaces>,
     /// Surface pairs and feature pairs within reach.
     pub(super) pairs: Vec<Pair>,
+    /// Per free body of the graph: whether a surface pair joins it to another body (then
+    /// it is left out of the coarse correction, docs/physics.md §4.1).
+    pub(super) touches_another: Vec<bool>,
     /// Particle `i`'s pairs are `refs[start[i]..start[i + 1]]`.
     start: Vec<u32>,
     refs: Vec<u32>,
@@ -285,6 +288,37 @@ impl Detection {
             .map(|&k| &self.pairs[k as usize])
     }
 
+    /// Marks the graph's free bodies that a surface pair joins to another body: corrected
+    /// alone, each would push the other back and forth (a stack jitters).
+    fn mark_touching_bodies(&mut self, graph: &Graph) {
+        self.touches_another.clear();
+        self.touches_another.resize(graph.free_bodies.len(), false);
+        for pair in &self.pairs {
+            // A feature pair's other side is a collider, not a body.
+            if matches!(pair.sides, Sides::Feature(_)) {
+                continue;
+            }
+            let bodies = pair
+                .ids
+                .iter()
+                .filter(|&&j| j != u32::MAX)
+                .map(|&j| graph.body_of[j as usize]);
+            let mut others = bodies.clone();
+            let Some(first) = others.next() else {
+                continue;
+            };
+            if others.all(|b| b == first) {
+                continue;
+            }
+            // Bodies with no free index (pinned ones) have nothing to mark.
+            for b in bodies {
+                if let Some(t) = self.touches_another.get_mut(b as usize) {
+                    *t = true;
+                }
+            }
+        }
+    }
+
     /// Whether any pair was found.
     pub(super) fn has_pairs(&self) -> bool {
         !self.pairs.is_empty()
@@ -346,6 +380,7 @@ impl Detection {
         let surface_reach = SURFACE_REACH * h_max;
         self.detect_surfaces(model, x, surface_reach);
         self.index_pairs(n, p);
+        self.mark_touching_bodies(graph);
         self.set_bounds(model, p, (x, y));
     }
 

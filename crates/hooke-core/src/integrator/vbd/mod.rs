@@ -291,19 +291,8 @@ fn translate_bodies(
     let (mut largest, mut clipped) = (0.0f64, false);
     let graph = local.graph;
     for (k, body) in graph.free_bodies.iter().enumerate() {
-        // A body touching another moves with it in its contacts: corrected alone, each
-        // would push the other back and forth (a stack jitters). Those keep the sweeps.
-        let touches_another = body.iter().any(|&i| {
-            local.detection.pairs_of(i as usize).any(|pair| {
-                // A feature pair's other side is a collider, not a body.
-                !matches!(pair.sides, pairs::Sides::Feature(_))
-                    && pair
-                        .ids
-                        .iter()
-                        .any(|&j| graph.body_of[j as usize] != k as u32)
-            })
-        });
-        if touches_another {
+        // A body touching another is left to the sweeps (see `mark_touching_bodies`).
+        if local.detection.touches_another[k] {
             continue;
         }
         let chunks = body.len().div_ceil(CHUNK);
