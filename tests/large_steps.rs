@@ -116,13 +116,24 @@ fn scene_from_text(text: &str) -> Scene {
 }
 
 /// A square sheet of `n × n` particles, 0.4 m wide, thickness 5 mm, with a collider and
-/// its response, stepped by block descent at a 60 Hz frame.
+/// its response, stepped by block descent at step `dt`.
 fn sheet_scene(n: usize, origin: [f64; 3], rotate_z: f64, collider: &str, dt: f64) -> Scene {
+    sheet_with(n, origin, rotate_z, collider, ("vbd", dt))
+}
+
+/// [`sheet_scene`] stepped by `integrator` at `dt`.
+pub(crate) fn sheet_with(
+    n: usize,
+    origin: [f64; 3],
+    rotate_z: f64,
+    collider: &str,
+    (integrator, dt): (&str, f64),
+) -> Scene {
     scene_from_text(&format!(
         r#"
 name = "sheet"
 [simulation]
-integrator = "vbd"
+integrator = "{integrator}"
 dt = {dt}
 duration = 2.0
 every = 1
@@ -156,9 +167,9 @@ kd = 0.005
     ))
 }
 
-/// A frictionless-restitution plane through the origin with unit `normal` (in the x-y plane)
+/// A restitution plane (`cr` 0) through the origin with unit `normal` (in the x-y plane)
 /// and Coulomb coefficient `mu`, as a scene's collider table.
-fn incline(normal: &Vec3, mu: f64) -> String {
+pub(crate) fn incline(normal: &Vec3, mu: f64) -> String {
     format!(
         r#"
 [[collider]]
@@ -176,7 +187,7 @@ friction = {mu}
 
 /// How far the sheet's centroid moves along `downhill` over three runs of `steps` steps,
 /// and its acceleration from the three positions' second difference.
-fn slide(scene: &mut Scene, downhill: &Vec3, steps: u64) -> (f64, f64) {
+pub(crate) fn slide(scene: &mut Scene, downhill: &Vec3, steps: u64) -> (f64, f64) {
     let along = |scene: &Scene| {
         let p = scene.simulation.particles();
         let c: Vec3 = p.x.iter().sum::<Vec3>() / p.len() as f64;

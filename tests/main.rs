@@ -9,6 +9,7 @@ mod common;
 mod conservation;
 mod contact;
 mod determinism;
+mod friction;
 mod images;
 mod large_steps;
 mod layout;

@@ -65,7 +65,7 @@ fn ground(cr: f64, friction: f64) -> ColliderSpec {
         },
         response: ResponseSpec::Restitution {
             cr: Fraction::of(cr),
-            friction: Fraction::of(friction),
+            friction: NonNegative::of(friction),
         },
     }
 }
@@ -337,7 +337,7 @@ pub fn flag() -> SceneSpec {
                 },
                 response: ResponseSpec::Restitution {
                     cr: Fraction::of(0.0),
-                    friction: Fraction::of(0.3),
+                    friction: NonNegative::of(0.3),
                 },
             },
         ],

@@ -459,8 +459,8 @@ pub enum ResponseSpec {
     Restitution {
         /// Coefficient of restitution.
         cr: Fraction,
-        /// Fraction of tangential velocity removed per contact (default 0).
-        friction: Fraction,
+        /// Coulomb's coefficient of friction μ (default 0: frictionless).
+        friction: NonNegative,
     },
     /// Projection and a full stop after each step.
     Stick,

@@ -197,7 +197,7 @@ pub(crate) struct ResponseTable {
     kc: Option<NonNegative>,
     dc: Option<NonNegative>,
     cr: Option<Fraction>,
-    friction: Option<Fraction>,
+    friction: Option<NonNegative>,
 }
 
 #[derive(Deserialize)]
@@ -230,7 +230,7 @@ impl TryFrom<ResponseTable> for ResponseSpec {
                 only("restitution", &["cr", "friction"], &present)?;
                 ResponseSpec::Restitution {
                     cr: need("restitution", "cr", t.cr)?,
-                    friction: t.friction.unwrap_or(Fraction::of(0.0)),
+                    friction: t.friction.unwrap_or(NonNegative::of(0.0)),
                 }
             }
             ResponseKind::Stick => {

@@ -15,11 +15,12 @@ pub enum Response {
         dc: f64,
     },
     /// After each full step: moved to the surface; an inward normal velocity `v·n < 0` becomes
-    /// `-cr (v·n)`; the tangential velocity is scaled by `1 - friction`.
+    /// `-cr (v·n)`, and Coulomb friction takes at most `friction` times that normal impulse
+    /// off the tangential velocity (docs/physics.md §3.3).
     Restitution {
         /// Coefficient of restitution in `[0, 1]`.
         cr: f64,
-        /// Fraction of tangential velocity removed at each contact, in `[0, 1]` (0 keeps it).
+        /// Coulomb's coefficient of friction μ ≥ 0 (0: frictionless).
         friction: f64,
     },
     /// After each full step: moved to the surface and stopped (the tabletop rule).
@@ -44,19 +45,29 @@ impl Response {
         }
     }
 
-    /// Applies a velocity-level response for one contact to a particle, in place.
+    /// Applies a velocity-level response for one contact to a particle, in place; `x0` is
+    /// where the particle started the step.
     ///
     /// The particle moves by `δ n` rather than to `contact.point` so that several contacts of
     /// one collider (the faces at a box corner) compose into the nearest point of all of them.
-    pub fn respond(&self, contact: &Contact, x: &mut Vec3, v: &mut Vec3) {
+    /// Friction acts within the step: the share of the tangential velocity it takes off is
+    /// also taken off the step's tangential displacement, so a contact that sticks does not
+    /// creep by the one step's slide that came before the response.
+    pub fn respond(&self, contact: &Contact, x0: &Vec3, x: &mut Vec3, v: &mut Vec3) {
         match *self {
             Self::Penalty { .. } => {}
             Self::Restitution { cr, friction } => {
-                *x += contact.normal * contact.depth;
-                let vn = v.dot(&contact.normal);
+                let n = contact.normal;
+                *x += n * contact.depth;
+                let vn = v.dot(&n);
                 if vn < 0.0 {
-                    let tangential = (*v - contact.normal * vn) * (1.0 - friction);
-                    *v = tangential + contact.normal * (-cr * vn);
+                    let tangential = *v - n * vn;
+                    let cut = coulomb_cut(friction, -(1.0 + cr) * vn, &tangential);
+                    *v = tangential - tangential * cut + n * (-cr * vn);
+                    if cut > 0.0 {
+                        let moved = *x - x0;
+                        *x -= (moved - n * n.dot(&moved)) * cut;
+                    }
                 }
             }
             Self::Stick => {
@@ -66,3 +77,21 @@ impl Response {
         }
     }
 }
+
+/// The share of the tangential velocity `tangential` that Coulomb friction with coefficient
+/// `mu` takes off after a normal velocity change `dvn ≥ 0`: at most `mu dvn`, all of it when
+/// that is enough (the contact sticks). The same law in every integrator (a velocity change
+/// is an impulse over the mass), so a sliding contact decelerates at `mu` times its normal
+/// acceleration whatever the step.
+#[inline]
+pub(crate) fn coulomb_cut(mu: f64, dvn: f64, tangential: &Vec3) -> f64 {
+    let t = tangential.norm();
+    if t > COULOMB_EPS {
+        (mu * dvn / t).min(1.0)
+    } else {
+        0.0
+    }
+}
+
+/// Tangential speeds below this have no direction to oppose, m/s.
+const COULOMB_EPS: f64 = 1e-12;

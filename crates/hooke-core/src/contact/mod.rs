@@ -37,7 +37,7 @@ pub mod proximity;
 mod respond;
 
 use crate::collider::Feature;
-use crate::collider::response::Response;
+use crate::collider::response::{Response, coulomb_cut};
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
 use grid::Grid;
@@ -61,8 +61,8 @@ const NONE: u32 = u32::MAX;
 enum Rule {
     /// Surface against surface: inelastic, Coulomb friction with this coefficient.
     Coulomb(f64),
-    /// Against a collider with restitution `cr`, keeping `keep` of the tangential velocity.
-    Bounce { cr: f64, keep: f64 },
+    /// Against a collider with restitution `cr` and Coulomb friction `mu`.
+    Bounce { cr: f64, mu: f64 },
     /// Against a stick collider: the touching point stops.
     Stop,
 }
@@ -70,12 +70,9 @@ enum Rule {
 impl Rule {
     fn of(response: &Response) -> Self {
         match *response {
-            Response::Restitution { cr, friction } => Self::Bounce {
-                cr,
-                keep: 1.0 - friction,
-            },
+            Response::Restitution { cr, friction } => Self::Bounce { cr, mu: friction },
             Response::Stick => Self::Stop,
-            Response::Penalty { .. } => Self::Bounce { cr: 0.0, keep: 1.0 },
+            Response::Penalty { .. } => Self::Bounce { cr: 0.0, mu: 0.0 },
         }
     }
 }
@@ -943,16 +940,11 @@ pub(crate) fn phase(
             let du = match s.rule {
                 Rule::Stop => -u,
                 _ if un >= 0.0 => continue,
-                Rule::Bounce { cr, keep } => s.n * (-(1.0 + cr) * un) + ut * (keep - 1.0),
-                Rule::Coulomb(mu) => {
-                    let t = ut.norm();
-                    let cut = if t > EPS {
-                        (mu * -un / t).min(1.0)
-                    } else {
-                        0.0
-                    };
-                    s.n * -un - ut * cut
+                Rule::Bounce { cr, mu } => {
+                    let dvn = -(1.0 + cr) * un;
+                    s.n * dvn - ut * coulomb_cut(mu, dvn, &ut)
                 }
+                Rule::Coulomb(mu) => s.n * -un - ut * coulomb_cut(mu, -un, &ut),
             };
             s.spread(&p.inv_mass, &mut p.v, du / c);
         }

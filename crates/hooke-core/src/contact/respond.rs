@@ -155,14 +155,14 @@ pub(crate) fn respond_one(
         let mut touched = false;
         let mut apply = |c: Contact| {
             touched = true;
-            slot.response.respond(&c, x, v);
+            slot.response.respond(&c, x0, x, v);
         };
         // With no margin this is `contacts`, the Collider contract says.
         slot.shape.contacts_within(&here, margin, &mut apply);
         if !touched && let Some(mut c) = slot.shape.crossing(x0, &here) {
             touched = true;
             c.depth += margin;
-            slot.response.respond(&c, x, v);
+            slot.response.respond(&c, x0, x, v);
         }
         held |= touched && matches!(slot.response, Response::Stick);
         if let Some(skip) = skip.as_deref_mut()
