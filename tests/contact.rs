@@ -266,7 +266,7 @@ fn skipping_what_cannot_touch_changes_no_bit() {
             *size = [48, 48];
             *spacing = hooke_scene::spec::Positive::of(1.6 / 47.0);
         }
-        body.mass = hooke_scene::spec::Positive::of(0.4 / (48.0 * 48.0));
+        body.mass = Some(hooke_scene::spec::Positive::of(0.4 / (48.0 * 48.0)));
         body.pins.clear();
     };
     let cases: [(&str, Option<&str>, bool, u64); 5] = [

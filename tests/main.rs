@@ -13,6 +13,7 @@ mod friction;
 mod images;
 mod large_steps;
 mod layout;
+mod material;
 mod oscillator;
 mod roundtrip;
 mod scenes;

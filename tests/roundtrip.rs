@@ -93,7 +93,7 @@ proptest! {
         spec.simulation.gravity = gravity.map(Finite::of);
         spec.simulation.drag = NonNegative::of(drag);
         for body in &mut spec.bodies {
-            body.mass = Positive::of(mass);
+            body.mass = Some(Positive::of(mass));
             body.origin = origin.map(Finite::of);
             if let Some(p) = &mut body.springs.structural {
                 p.ks = NonNegative::of(ks);

@@ -134,4 +134,5 @@ scene_snapshots! {
     snapshot_cloth_table => "cloth-table",
     snapshot_cloth_pile => "cloth-pile",
     snapshot_flag => "flag",
+    snapshot_tablecloth => "tablecloth",
 }

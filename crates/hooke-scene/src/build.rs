@@ -189,7 +189,7 @@ impl SceneSpec {
         }
         let built = build_body(body, key, particles.len())?;
         let n = built.local.len();
-        place_particles(body, key, &built.local, particles)?;
+        place_particles(body, key, (&built.local, &built.masses), particles)?;
         for (k, &pin) in body.pins.iter().enumerate() {
             if pin >= n {
                 return Err(invalid(
@@ -301,7 +301,7 @@ struct Bodies {
 fn place_particles(
     body: &BodySpec,
     key: &str,
-    local: &[Vec3],
+    (local, masses): (&[Vec3], &[f64]),
     particles: &mut Particles,
 ) -> Result<(), BuildError> {
     let r = rotation(&body.rotate);
@@ -356,7 +356,7 @@ fn place_particles(
                 ),
             ));
         }
-        particles.push(x, v, body.mass.get());
+        particles.push(x, v, masses[p]);
     }
     Ok(())
 }
@@ -502,11 +502,76 @@ fn body_surface(
 
 struct BuiltBody {
     local: Vec<Vec3>,
+    /// Per particle, kg.
+    masses: Vec<f64>,
     springs: Vec<Spring>,
     topology: Topology,
 }
 
 fn build_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, BuildError> {
+    if let Some(material) = &body.material {
+        return material_body(body, material, key, offset);
+    }
+    let Some(mass) = body.mass else {
+        return Err(invalid(
+            format!("{key}.mass"),
+            "missing: give `mass` (kg per particle) and `springs`, or a `[body.material]`",
+        ));
+    };
+    let mut built = spring_body(body, key, offset)?;
+    built.masses = vec![mass.get(); built.local.len()];
+    Ok(built)
+}
+
+/// A grid given as a material: its masses and springs derived for its spacing.
+fn material_body(
+    body: &BodySpec,
+    material: &crate::spec::MaterialSpec,
+    key: &str,
+    offset: usize,
+) -> Result<BuiltBody, BuildError> {
+    let given: Vec<&str> = [
+        ("mass", body.mass.is_some()),
+        ("springs", !body.springs.is_empty()),
+    ]
+    .iter()
+    .filter(|(_, on)| *on)
+    .map(|(name, _)| *name)
+    .collect();
+    if !given.is_empty() {
+        return Err(invalid(
+            format!("{key}.material"),
+            format!(
+                "a material gives the masses and springs: remove {} (or the material)",
+                given
+                    .iter()
+                    .map(|k| format!("`{k}`"))
+                    .collect::<Vec<_>>()
+                    .join(" and ")
+            ),
+        ));
+    }
+    let ShapeSpec::Grid { size, spacing } = &body.shape else {
+        return Err(invalid(
+            format!("{key}.material"),
+            "a material is for a cloth: the body's shape must be a `grid`",
+        ));
+    };
+    let material = material.resolve(&format!("{key}.material"))?;
+    let mut built = spring_body(body, key, offset)?;
+    built.masses = material.masses(*size, spacing.get());
+    let n = built.local.len();
+    let mut held = vec![false; n];
+    for &p in body.pins.iter().filter(|&&p| p < n) {
+        held[p] = true;
+    }
+    let pinned = |p: usize| held[p];
+    built.springs = material.springs(*size, spacing.get(), offset, &pinned);
+    Ok(built)
+}
+
+/// A body's particles and the springs its `springs` table gives (masses left empty).
+fn spring_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, BuildError> {
     let (lattice, h, topology) = match &body.shape {
         ShapeSpec::Chain { count, spacing } => (
             Lattice {
@@ -541,6 +606,7 @@ fn build_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, Bu
             let springs = pairs(body, key, &local, offset)?;
             return Ok(BuiltBody {
                 local,
+                masses: Vec::new(),
                 springs,
                 topology: Topology::Points,
             });
@@ -580,6 +646,7 @@ fn build_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, Bu
     springs.extend(pairs(body, key, &local, offset)?);
     Ok(BuiltBody {
         local,
+        masses: Vec::new(),
         springs,
         topology,
     })

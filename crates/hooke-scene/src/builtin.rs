@@ -42,7 +42,7 @@ fn body(
 ) -> BodySpec {
     BodySpec {
         name: name.into(),
-        mass: Positive::of(mass),
+        mass: Some(Positive::of(mass)),
         origin: f3(origin),
         rotate: f3([0.0; 3]),
         velocity: f3([0.0; 3]),
@@ -51,10 +51,24 @@ fn body(
         velocities: None,
         shape,
         springs,
+        material: None,
         thickness: None,
         self_collision: None,
         friction: None,
         aero: None,
+    }
+}
+
+/// A shipped mesh (`builtin:…`) where it was modelled, with `response`.
+fn shipped_mesh(path: &str, response: ResponseSpec) -> ColliderSpec {
+    ColliderSpec {
+        shape: ColliderShapeSpec::Mesh {
+            path: path.into(),
+            translate: f3([0.0; 3]),
+            rotate: f3([0.0; 3]),
+            scale: [Positive::of(1.0); 3],
+        },
+        response,
     }
 }
 
@@ -246,15 +260,7 @@ pub fn cloth_table() -> SceneSpec {
         bodies: vec![b],
         colliders: vec![
             ground(0.2, 0.5),
-            ColliderSpec {
-                shape: ColliderShapeSpec::Mesh {
-                    path: "builtin:table.obj".into(),
-                    translate: f3([0.0; 3]),
-                    rotate: f3([0.0; 3]),
-                    scale: [Positive::of(1.0); 3],
-                },
-                response: ResponseSpec::Stick,
-            },
+            shipped_mesh("builtin:table.obj", ResponseSpec::Stick),
         ],
         force_field: None,
     }
@@ -345,12 +351,62 @@ pub fn flag() -> SceneSpec {
     }
 }
 
+/// Side of `tablecloth`'s cloth, metres, and its particles per side.
+pub const TABLECLOTH: (f64, usize) = (1.6, 36);
+
+/// A cotton tablecloth given as a material (`preset = "cotton"`: 150 g/m², B = 5 µN·m,
+/// docs/physics.md §1.1) of 1.6 m square, 36×36, dropped 10 cm onto the square table
+/// (`builtin:square-table.obj`, side 1 m, top at y = 0.9), in still air, with Coulomb
+/// friction 0.5 on the top: it hangs in folds, its corners lowest.
+pub fn tablecloth() -> SceneSpec {
+    let (side, n) = TABLECLOTH;
+    let mut cloth = body(
+        "cloth",
+        1.0,
+        [-side / 2.0, 1.0, -side / 2.0],
+        ShapeSpec::Grid {
+            size: [n, n],
+            spacing: Positive::of(side / (n - 1) as f64),
+        },
+        SpringsSpec::default(),
+    );
+    cloth.mass = None;
+    cloth.material = Some(MaterialSpec {
+        preset: Some("cotton".into()),
+        ..MaterialSpec::default()
+    });
+    let mut simulation = sim(Integrator::Symplectic, 2.5e-4, 3.0, 40, 0.0);
+    simulation.air = Some(AirSpec {
+        density: Positive::of(hooke_core::forces::air::SEA_LEVEL_DENSITY),
+        wind: f3([0.0; 3]),
+        gust: None,
+    });
+    SceneSpec {
+        name: "tablecloth".into(),
+        description: "a 36x36 cotton tablecloth (a material in SI units) dropped onto the square table; hangs in folds"
+            .into(),
+        simulation,
+        bodies: vec![cloth],
+        colliders: vec![
+            ground(0.0, 0.5),
+            shipped_mesh(
+                "builtin:square-table.obj",
+                ResponseSpec::Restitution {
+                    cr: Fraction::of(0.0),
+                    friction: NonNegative::of(0.5),
+                },
+            ),
+        ],
+        force_field: None,
+    }
+}
+
 /// Makes a built-in scene.
 pub type Maker = fn() -> SceneSpec;
 
-/// The built-in scenes by name: the course document's five, then the contact scene and the
-/// air scene.
-pub const BUILTINS: [(&str, Maker); 7] = [
+/// The built-in scenes by name: the course document's five, then the contact scene, the
+/// air scene and the material tablecloth.
+pub const BUILTINS: [(&str, Maker); 8] = [
     ("single-spring", single_spring),
     ("chain", chain),
     ("jello-cube", jello_cube),
@@ -358,6 +414,7 @@ pub const BUILTINS: [(&str, Maker); 7] = [
     ("cloth-table", cloth_table),
     ("cloth-pile", cloth_pile),
     ("flag", flag),
+    ("tablecloth", tablecloth),
 ];
 
 /// The built-in scene called `name`.

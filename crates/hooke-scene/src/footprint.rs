@@ -133,7 +133,10 @@ impl SceneSpec {
                 .fold(1u64, |a, &n| a.saturating_mul(n as u64));
             let generated = !matches!(body.shape, ShapeSpec::Points { .. });
             let mut springs = body.springs.pairs.len() as u64;
-            if generated {
+            let material = body.material.as_ref().and_then(|m| m.resolve("").ok());
+            if let (Some(m), ShapeSpec::Grid { size, .. }) = (material, &body.shape) {
+                springs = springs.saturating_add(m.spring_count(*size));
+            } else if generated {
                 for kind in [SpringKind::Structural, SpringKind::Shear, SpringKind::Bend] {
                     if body.springs.params(kind).is_some() {
                         springs = springs.saturating_add(lattice.edge_count(kind) as u64);

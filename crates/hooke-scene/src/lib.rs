@@ -4,7 +4,8 @@
 //!   [`load_scene`], written by [`to_toml`];
 //! * generators for chains, cloth grids and jelly lattices with structural, shear and bend
 //!   springs ([`generators`]);
-//! * the seven built-in scenes ([`builtin`]): the course's five, `cloth-pile` and `flag`;
+//! * the eight built-in scenes ([`builtin`]): the course's five, `cloth-pile`, `flag` and
+//!   the material `tablecloth`;
 //! * building a ready-to-step [`Scene`] from a description ([`SceneSpec::build`]).
 //!
 //! ```
@@ -27,6 +28,7 @@ mod error;
 pub mod footprint;
 pub mod generators;
 mod limits;
+pub mod material;
 mod overrides;
 mod scene;
 mod scene_toml;

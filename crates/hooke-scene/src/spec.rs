@@ -245,8 +245,9 @@ fn is_zero(x: &NonNegative) -> bool {
 pub struct BodySpec {
     /// Name of the body.
     pub name: String,
-    /// Mass of every particle in kg.
-    pub mass: Positive,
+    /// Mass of every particle in kg (not with `material`, which gives the masses).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mass: Option<Positive>,
     /// Where the generator's local origin goes, metres.
     #[serde(default = "origin")]
     pub origin: [Finite; 3],
@@ -268,9 +269,13 @@ pub struct BodySpec {
     pub velocities: Option<Vec<[Finite; 3]>>,
     /// The generator: `chain`, `grid`, `lattice` or `points`.
     pub shape: ShapeSpec,
-    /// Springs by topology and explicit pairs.
-    #[serde(default)]
+    /// Springs by topology and explicit pairs (not with `material`).
+    #[serde(default, skip_serializing_if = "SpringsSpec::is_empty")]
     pub springs: SpringsSpec,
+    /// A cloth's material in SI units, from which a grid's masses and springs are derived
+    /// for its spacing (docs/physics.md §1.1); instead of `mass` and `springs`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<MaterialSpec>,
     /// Contact thickness in metres: colliders and other surfaces are kept this far from the
     /// body's particles and triangles (`docs/physics.md` §3). Default: 5 mm for a `grid`
     /// (cloth), capped at a quarter of its spacing; 0 for other shapes, whose contacts are
@@ -362,6 +367,32 @@ pub struct SpringsSpec {
     /// Explicit springs between particles of this body.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub pairs: Vec<PairSpec>,
+}
+
+/// `[body.material]`: a cloth in SI units; any key overrides its `preset`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// A named material (`cotton`, `silk`, `wool`, `denim`) whose values the other keys
+    /// override.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset: Option<String>,
+    /// Areal density, kg/m².
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<Positive>,
+    /// Membrane stiffness per unit width along the grid's lines, N/m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stretch: Option<Positive>,
+    /// Membrane shear stiffness per unit width (the diagonal springs), N/m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear: Option<NonNegative>,
+    /// Bending rigidity per unit width `B`, N·m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bending: Option<NonNegative>,
+    /// Stiffness-proportional damping, seconds: each membrane spring's `kd` is this times
+    /// its `ks`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping: Option<NonNegative>,
 }
 
 /// One explicit spring.
@@ -477,6 +508,14 @@ pub struct ForceFieldSpec {
 }
 
 impl SpringsSpec {
+    /// Whether no spring is given.
+    pub fn is_empty(&self) -> bool {
+        self.structural.is_none()
+            && self.shear.is_none()
+            && self.bend.is_none()
+            && self.pairs.is_empty()
+    }
+
     /// The parameters of one family.
     pub fn params(&self, kind: SpringKind) -> Option<SpringParams> {
         match kind {

@@ -40,7 +40,7 @@ pub fn cloth(n: usize) -> SceneSpec {
         },
         bodies: vec![BodySpec {
             name: "cloth".into(),
-            mass: Positive::of(1.0 / (n * n) as f64),
+            mass: Some(Positive::of(1.0 / (n * n) as f64)),
             origin: [Finite::of(0.0), Finite::of(1.0), Finite::of(0.0)],
             rotate: zero,
             velocity: zero,
@@ -58,6 +58,7 @@ pub fn cloth(n: usize) -> SceneSpec {
                 pairs: Vec::new(),
             },
             // The workload measures springs alone: no contact phase.
+            material: None,
             thickness: Some(NonNegative::of(0.0)),
             self_collision: None,
             friction: None,

@@ -405,7 +405,7 @@ impl World {
             },
             bodies: vec![BodySpec {
                 name: "jello".into(),
-                mass: positive("mass", self.mass)?,
+                mass: Some(positive("mass", self.mass)?),
                 origin: [Finite::of(0.0); 3],
                 rotate: [Finite::of(0.0); 3],
                 velocity: [Finite::of(0.0); 3],
@@ -423,6 +423,7 @@ impl World {
                     pairs: Vec::new(),
                 },
                 // docs/physics.md §5: a world's jelly has SPEC's bare per-particle contacts.
+                material: None,
                 thickness: None,
                 self_collision: None,
                 friction: None,
@@ -475,6 +476,9 @@ impl World {
         if !body.pins.is_empty() {
             return no("jello worlds have no pinned points");
         }
+        let Some(mass) = body.mass.filter(|_| body.material.is_none()) else {
+            return no("jello worlds give one mass per particle, not a material");
+        };
         if body.thickness.is_some_and(|h| h.get() != 0.0) {
             return no("jello worlds have no contact thickness (bare per-particle contacts)");
         }
@@ -536,7 +540,7 @@ impl World {
             d_elastic: p.kd.get(),
             k_collision,
             d_collision,
-            mass: body.mass.get(),
+            mass: mass.get(),
             plane,
             resolution,
             field,

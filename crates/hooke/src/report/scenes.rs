@@ -15,7 +15,7 @@ use serde::Serialize;
 use std::path::Path;
 
 /// The golden stills of `golden/`, built into the binary so the report needs no checkout.
-const GOLDEN: [(&str, &[u8]); 7] = [
+const GOLDEN: [(&str, &[u8]); 8] = [
     (
         "single-spring",
         include_bytes!("../../../../golden/single-spring.png"),
@@ -38,6 +38,10 @@ const GOLDEN: [(&str, &[u8]); 7] = [
         include_bytes!("../../../../golden/cloth-pile.png"),
     ),
     ("flag", include_bytes!("../../../../golden/flag.png")),
+    (
+        "tablecloth",
+        include_bytes!("../../../../golden/tablecloth.png"),
+    ),
 ];
 
 /// Scenes quick enough for `--quick`.
@@ -200,7 +204,7 @@ fn check(name: &str, golden: &[u8], files: &mut Pending) -> Result<SceneCheck> {
     })
 }
 
-/// The scenes checked: all seven, or the quick ones.
+/// The scenes checked: all eight, or the quick ones.
 pub(crate) fn names(quick: bool) -> Vec<&'static str> {
     GOLDEN
         .iter()
