@@ -14,6 +14,7 @@ mod images;
 mod large_steps;
 mod layout;
 mod material;
+mod motion;
 mod oscillator;
 mod roundtrip;
 mod scenes;

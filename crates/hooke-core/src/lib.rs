@@ -60,6 +60,7 @@ pub use forces::air::{AeroSurface, Air, Gust};
 pub use forces::field::ForceField;
 pub use forces::spring::{Spring, SpringKind};
 pub use integrator::{Integrator, UnknownIntegrator};
+pub use model::motion::{Key, KeyError, Keyframes, PinMotion};
 pub use model::surface::{DEFAULT_CLOTH_THICKNESS, DEFAULT_SURFACE_FRICTION, Surface};
 pub use model::{Attachment, ColliderSlot, Model};
 pub use number::Num;

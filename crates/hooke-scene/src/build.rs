@@ -8,7 +8,7 @@ use crate::limits::{
 };
 use crate::scene::{Body, ColliderGeometry, Scene, Topology};
 use crate::spec::*;
-use hooke_core::{AeroSurface, Air, Gust, Num, SANE_BOUND, StartInside};
+use hooke_core::{AeroSurface, Air, Gust, Num, PinMotion, SANE_BOUND, StartInside};
 use hooke_core::{
     ColliderSlot, DEFAULT_CLOTH_THICKNESS, DEFAULT_SURFACE_FRICTION, ForceField, Model, Particles,
     Simulation, Spring, SpringKind, Surface, Vec3,
@@ -100,6 +100,7 @@ impl SceneSpec {
                 }),
             }),
             aero: built.aero,
+            pin_motions: built.pin_motions,
         };
         let mut simulation = Simulation::new(
             built.particles,
@@ -202,6 +203,10 @@ impl SceneSpec {
             }
             particles.pin(start + pin);
         }
+        if let Some(motion) = &body.pin_motion {
+            out.pin_motions
+                .push(pin_motion(body, motion, key, start, particles)?);
+        }
         out.springs.extend(built.springs);
         let triangles = crate::surface::triangles(built.topology, start);
         let surface = body_surface(body, key, &built.local, start..start + n, triangles)?;
@@ -293,6 +298,7 @@ struct Bodies {
     bodies: Vec<Body>,
     surfaces: Vec<Surface>,
     aero: Vec<AeroSurface>,
+    pin_motions: Vec<PinMotion>,
 }
 
 /// Pushes a body's particles: at its `positions`, or its local layout rotated and moved to
@@ -521,6 +527,29 @@ fn build_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, Bu
     let mut built = spring_body(body, key, offset)?;
     built.masses = vec![mass.get(); built.local.len()];
     Ok(built)
+}
+
+/// A body's keyframed pins (docs/physics.md §1.2): its pinned particles, moved by `motion`.
+fn pin_motion(
+    body: &BodySpec,
+    motion: &crate::spec::MotionSpec,
+    key: &str,
+    start: usize,
+    particles: &Particles,
+) -> Result<PinMotion, BuildError> {
+    if body.pins.is_empty() {
+        return Err(invalid(
+            format!("{key}.pin_motion"),
+            "it moves the body's pinned particles, and the body has none: give `pins`",
+        ));
+    }
+    let keys = motion
+        .keyframes()
+        .map_err(|e| invalid(format!("{key}.pin_motion.keys"), e.to_string()))?;
+    let mut ids: Vec<u32> = body.pins.iter().map(|&p| (start + p) as u32).collect();
+    ids.sort_unstable();
+    ids.dedup();
+    Ok(PinMotion::new(ids, &particles.x, keys))
 }
 
 /// A grid given as a material: its masses and springs derived for its spacing.

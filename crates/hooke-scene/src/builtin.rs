@@ -52,6 +52,7 @@ fn body(
         shape,
         springs,
         material: None,
+        pin_motion: None,
         thickness: None,
         self_collision: None,
         friction: None,

@@ -272,6 +272,10 @@ pub struct BodySpec {
     /// Springs by topology and explicit pairs (not with `material`).
     #[serde(default, skip_serializing_if = "SpringsSpec::is_empty")]
     pub springs: SpringsSpec,
+    /// Keys that move the body's pinned particles rigidly about their centroid at the start
+    /// (docs/physics.md §1.2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pin_motion: Option<MotionSpec>,
     /// A cloth's material in SI units, from which a grid's masses and springs are derived
     /// for its spacing (docs/physics.md §1.1); instead of `mass` and `springs`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -367,6 +371,43 @@ pub struct SpringsSpec {
     /// Explicit springs between particles of this body.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub pairs: Vec<PairSpec>,
+}
+
+/// `[body.pin_motion]` (and later colliders' motions): `keys = [{ t, translate, rotate }, …]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotionSpec {
+    /// The keys, in increasing time.
+    pub keys: Vec<KeySpec>,
+}
+
+/// One key of a motion.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KeySpec {
+    /// Seconds.
+    pub t: Finite,
+    /// Metres, relative to the start.
+    pub translate: [Finite; 3],
+    /// Degrees about x, then y, then z, relative to the start (default none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotate: Option<[Finite; 3]>,
+}
+
+impl MotionSpec {
+    /// The keys as the core's, checked (at least one, times increasing).
+    pub fn keyframes(&self) -> Result<hooke_core::Keyframes, hooke_core::KeyError> {
+        hooke_core::Keyframes::new(
+            self.keys
+                .iter()
+                .map(|k| hooke_core::Key {
+                    t: k.t.get(),
+                    translate: vec3(&k.translate),
+                    rotate: k.rotate.as_ref().map_or(Vec3::zeros(), vec3),
+                })
+                .collect(),
+        )
+    }
 }
 
 /// `[body.material]`: a cloth in SI units; any key overrides its `preset`.

@@ -59,6 +59,7 @@ pub fn cloth(n: usize) -> SceneSpec {
             },
             // The workload measures springs alone: no contact phase.
             material: None,
+            pin_motion: None,
             thickness: Some(NonNegative::of(0.0)),
             self_collision: None,
             friction: None,

@@ -424,6 +424,7 @@ impl World {
                 },
                 // docs/physics.md §5: a world's jelly has SPEC's bare per-particle contacts.
                 material: None,
+                pin_motion: None,
                 thickness: None,
                 self_collision: None,
                 friction: None,

@@ -1,5 +1,6 @@
 //! The force model of a system: everything that is constant during a run.
 
+pub(crate) mod motion;
 pub(crate) mod surface;
 
 use crate::collider::response::Response;
@@ -7,6 +8,7 @@ use crate::collider::{Collider, Contact};
 use crate::forces::air::{AeroSurface, Air};
 use crate::forces::field::ForceField;
 use crate::forces::spring::Spring;
+use crate::model::motion::PinMotion;
 use crate::model::surface::Surface;
 use crate::particles::Vec3;
 
@@ -45,6 +47,8 @@ pub struct Model {
     /// The bodies' triangles that air acts on, with their coefficients (only read when
     /// `air` is set).
     pub aero: Vec<AeroSurface>,
+    /// Pinned particles that follow keys (docs/physics.md §1.2).
+    pub pin_motions: Vec<PinMotion>,
 }
 
 /// A zero-length damped spring from a particle to a point in space: the force

@@ -259,6 +259,7 @@ impl Simulation {
     /// [`Simulation::step`] on the current thread.
     fn step_here(&mut self) -> Result<(), Divergence> {
         let time = self.time();
+        self.start_pins(time);
         let report = self.integrator.step(
             &self.model,
             &mut self.particles,
@@ -278,6 +279,7 @@ impl Simulation {
                 &mut self.contacts,
             );
         self.step += 1;
+        self.end_pins(time + self.dt);
         divergence::check(StepEnd {
             model: &self.model,
             particles: &self.particles,
@@ -298,6 +300,31 @@ impl Simulation {
             self.integrator,
             self.dt,
         )
+    }
+
+    /// Keyframed pins at the step's start (docs/physics.md §1.2): each where its keys put it
+    /// at `t`, moving at its keys' mean velocity over the step, which the integrators keep
+    /// (a pinned particle's velocity never changes) and the springs' damping reads.
+    fn start_pins(&mut self, t: f64) {
+        let dt = self.dt;
+        let p = &mut self.particles;
+        for motion in &self.model.pin_motions {
+            for ((i, now), (_, next)) in motion.positions(t).zip(motion.positions(t + dt)) {
+                p.x[i] = now;
+                p.v[i] = (next - now) / dt;
+            }
+        }
+    }
+
+    /// Keyframed pins at the step's end: exactly where their keys put them at `t`, whatever
+    /// the integrator did with them.
+    fn end_pins(&mut self, t: f64) {
+        let p = &mut self.particles;
+        for motion in &self.model.pin_motions {
+            for (i, at) in motion.positions(t) {
+                p.x[i] = at;
+            }
+        }
     }
 
     /// Advances `steps` steps, stopping at the first divergence.

@@ -160,14 +160,20 @@ impl Renumbering {
         }
     }
 
-    /// Renumbers every particle index `model` holds: springs, attachments, surfaces' and
-    /// air's triangles (a surface's range stays its own, as renumberings keep bodies).
+    /// Renumbers every particle index `model` holds: springs, attachments, keyframed pins,
+    /// surfaces' and air's triangles (a surface's range stays its own, as renumberings keep
+    /// bodies).
     pub(crate) fn model(&self, model: &mut Model) {
         for s in &mut model.springs {
             (s.i, s.j) = (self.map(s.i), self.map(s.j));
         }
         for a in &mut model.attachments {
             a.particle = self.new_index(a.particle);
+        }
+        for m in &mut model.pin_motions {
+            for i in &mut m.particles {
+                *i = self.map(*i);
+            }
         }
         let triangles = model
             .surfaces

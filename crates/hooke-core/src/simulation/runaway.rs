@@ -26,7 +26,7 @@
 use crate::forces::air::AirForces;
 use crate::integrator::Integrator;
 use crate::model::Model;
-use crate::particles::Particles;
+use crate::particles::{Particles, Vec3};
 use crate::simulation::divergence::Divergence;
 use crate::simulation::stability::StabilityEstimate;
 use crate::simulation::summary;
@@ -145,8 +145,9 @@ impl EnergyWatch {
     /// The power that forces from outside the springs and gravity put in now, counting only
     /// where they push a particle along its motion.
     fn power(&mut self, model: &Model, p: &Particles, time: f64) -> f64 {
+        let pins = pin_power(model, p);
         if model.field.is_none() && model.air.is_none() && model.attachments.is_empty() {
-            return 0.0;
+            return pins;
         }
         self.air.ensure(&model.aero, p.len());
         let air = self
@@ -167,8 +168,37 @@ impl EnergyWatch {
             }
             power += f.dot(v).max(0.0);
         }
-        power
+        power + pins
     }
+}
+
+/// The power keyframed pins put in now: each moving pinned particle is held against its
+/// springs and its weight, so the holder's force is minus their sum, counted where it
+/// pushes along the particle's motion.
+fn pin_power(model: &Model, p: &Particles) -> f64 {
+    if model.pin_motions.is_empty() {
+        return 0.0;
+    }
+    let mut held = vec![Vec3::zeros(); p.len()];
+    let mut moving = vec![false; p.len()];
+    for m in &model.pin_motions {
+        for &i in &m.particles {
+            moving[i as usize] = true;
+        }
+    }
+    for s in &model.springs {
+        let (i, j) = (s.i as usize, s.j as usize);
+        if !(moving[i] || moving[j]) {
+            continue;
+        }
+        let f = s.force(&p.x[i], &p.x[j], &p.v[i], &p.v[j]);
+        held[i] -= f;
+        held[j] += f;
+    }
+    (0..p.len())
+        .filter(|&i| moving[i])
+        .map(|i| (held[i] - model.gravity * p.mass[i]).dot(&p.v[i]).max(0.0))
+        .sum()
 }
 
 /// The fastest particle.
