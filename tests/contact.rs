@@ -16,7 +16,7 @@ use hooke::report::crossings::{self, Tri};
 /// One exported frame: the cloth triangles with their corner indices, and the colliders'.
 pub(crate) struct Frame {
     pub(crate) cloth: Vec<(Tri, [u32; 3])>,
-    colliders: Vec<Tri>,
+    pub(crate) colliders: Vec<Tri>,
 }
 
 fn read_frame(path: &Path) -> Frame {

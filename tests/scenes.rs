@@ -135,4 +135,5 @@ scene_snapshots! {
     snapshot_cloth_pile => "cloth-pile",
     snapshot_flag => "flag",
     snapshot_tablecloth => "tablecloth",
+    snapshot_puck_sweep => "puck-sweep",
 }

@@ -53,6 +53,10 @@ class Simulation:
     @property
     def bodies(self) -> list[tuple[str, int, int]]:
         """(name, first particle, particle count) of every body."""
+    def collider_pose(
+        self, k: int
+    ) -> tuple[tuple[float, float, float], tuple[float, float, float]] | None:
+        """Collider k's (translate, rotate) now, metres and degrees; None if it does not move."""
     def render(
         self,
         width: int = 800,

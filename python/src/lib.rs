@@ -331,6 +331,25 @@ impl Simulation {
             .collect())
     }
 
+    /// Where collider `k` (in the scene file's order) is now: `(translate, rotate)`, metres
+    /// and degrees about x, then y, then z, relative to where the scene placed it; `None` for
+    /// a collider that does not move (docs/physics.md §2.1).
+    #[allow(clippy::type_complexity)]
+    fn collider_pose(&self, k: usize) -> PyResult<Option<([f64; 3], [f64; 3])>> {
+        let inner = self.lock()?;
+        let scene = &inner.scene;
+        if k >= scene.colliders.len() {
+            return Err(HookeError::new_err(format!(
+                "collider {k}: the scene has {} (0 to {})",
+                scene.colliders.len(),
+                scene.colliders.len().saturating_sub(1)
+            )));
+        }
+        Ok(scene
+            .collider_pose(k, scene.simulation.time())
+            .map(|pose| (pose.translate.into(), pose.rotate.into())))
+    }
+
     /// The scene's name.
     #[getter]
     fn name(&self) -> PyResult<String> {

@@ -172,6 +172,26 @@ def test_a_material_is_read_set_and_written_back(tmp_path):
     assert np.array_equal(again.masses, cotton.masses)
 
 
+def test_a_moving_colliders_pose_is_read_at_the_current_time(tmp_path):
+    text = subprocess.run([hooke_bin(), "scene", "hanging-cloth"], check=True,
+                          capture_output=True, text=True).stdout
+    text += """
+[[collider]]
+shape = { kind = "cylinder", center = [-1.5, 1.7, 0.0], radius = 0.15, thickness = 0.4 }
+response = { kind = "restitution", cr = 0.0, friction = 0.3 }
+motion = { keys = [{ t = 0.0, translate = [0.0, 0.0, 0.0] }, { t = 1.0, translate = [1.0, 0.0, 0.0], rotate = [0.0, 90.0, 0.0] }] }
+"""
+    path = tmp_path / "puck.toml"
+    path.write_text(text)
+    sim = hooke.load(str(path), duration=1.0)
+    assert sim.collider_pose(0) is None  # the ground does not move
+    sim.advance(0.5)
+    translate, rotate = sim.collider_pose(1)
+    assert np.allclose(translate, [0.5, 0.0, 0.0]) and np.allclose(rotate, [0.0, 45.0, 0.0])
+    with pytest.raises(hooke.HookeError, match="collider 2: the scene has 2"):
+        sim.collider_pose(2)
+
+
 def test_render_gives_an_rgb_picture_of_the_asked_size():
     sim = hooke.load("jello-cube")
     img = sim.render(width=160, height=120, style="both", supersample=1)

@@ -21,7 +21,7 @@ use hooke_scene::Overrides;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-/// Mass-spring simulation you can trust: eight built-in scenes (the course's five among them),
+/// Mass-spring simulation you can trust: nine built-in scenes (the course's five among them),
 /// jello worlds, your own scene files.
 #[derive(Parser)]
 #[command(name = "hooke", version, about)]
@@ -36,7 +36,7 @@ enum Command {
     Run(RunArgs),
     /// Render a still of a scene at a given time to PNG.
     Render(RenderArgs),
-    /// The main job: simulate the eight built-in scenes and write a still of each plus an
+    /// The main job: simulate the nine built-in scenes and write a still of each plus an
     /// animation.
     Demo {
         /// Output folder.

@@ -27,6 +27,8 @@ pub(crate) struct Tunnelling {
     thickness: f64,
     speed: f64,
     drop: f64,
+    /// The collider's own fastest keyed speed (zero for a still one), m/s.
+    moving: f64,
     per_step: f64,
     /// The largest step that keeps a step's travel within half the thickness.
     pub(crate) safe_dt: f64,
@@ -42,18 +44,23 @@ pub(crate) fn tunnelling(scene: &Scene) -> Vec<Tunnelling> {
     model
         .colliders
         .iter()
-        .filter_map(|slot| {
+        .enumerate()
+        .filter_map(|(k, slot)| {
             // A collider without thickness (an open sheet) is held by the crossing test,
             // not by depth: nothing to tunnel through.
             let thickness = slot.shape.thickness().filter(|t| *t > 0.0)?;
+            // A moving collider closes on a particle at their speeds' sum at worst.
+            let moving = collider_speed(scene, k);
+            let closing = speed + moving;
             Some(Tunnelling {
                 collider: slot.shape.name(),
                 thickness,
                 speed,
                 drop,
-                per_step: speed * sim.dt(),
-                safe_dt: if speed > 0.0 {
-                    0.5 * thickness / speed
+                moving,
+                per_step: closing * sim.dt(),
+                safe_dt: if closing > 0.0 {
+                    0.5 * thickness / closing
                 } else {
                     f64::INFINITY
                 },
@@ -68,9 +75,14 @@ impl Tunnelling {
     }
 
     pub(crate) fn describe(&self, dt: f64) -> String {
+        let moving = if self.moving > 0.0 {
+            format!(", and the collider moves at up to {:.2} m/s,", self.moving)
+        } else {
+            String::new()
+        };
         format!(
-            "{} is {:.1} mm thick at its thinnest; at {:.2} m/s (a fall of {:.2} m) a particle moves \
-             {:.1} mm per step of {} s",
+            "{} is {:.1} mm thick at its thinnest; at {:.2} m/s (a fall of {:.2} m){moving} a \
+             particle moves {:.1} mm per step of {} s relative to it",
             self.collider,
             self.thickness * 1e3,
             self.speed,
@@ -79,6 +91,36 @@ impl Tunnelling {
             Num(dt)
         )
     }
+}
+
+/// The fastest that any point of collider `k` moves along its keys, m/s (zero when it does
+/// not move): per pair of keys, the translation's speed plus the turn's rate (the angles'
+/// change, in radians, summed as a bound) times the farthest point's distance from the pivot.
+fn collider_speed(scene: &Scene, k: usize) -> f64 {
+    let Some(keys) = scene.spec.colliders[k]
+        .motion
+        .as_ref()
+        .and_then(|m| m.keyframes().ok())
+    else {
+        return 0.0;
+    };
+    let Some(pose) = scene.collider_pose(k, 0.0) else {
+        return 0.0;
+    };
+    let reach = scene.colliders[k]
+        .triangles(pose.pivot, 0.0, (pose.pivot, pose.pivot))
+        .iter()
+        .flatten()
+        .map(|p| (p - pose.pivot).norm())
+        .fold(0.0, f64::max);
+    keys.keys()
+        .windows(2)
+        .map(|w| {
+            let dt = w[1].t - w[0].t;
+            let turn = (w[1].rotate - w[0].rotate).map(f64::to_radians).abs().sum();
+            ((w[1].translate - w[0].translate).norm() + turn * reach) / dt
+        })
+        .fold(0.0, f64::max)
 }
 
 /// The fastest a particle can move, m/s: the larger of the fastest now and a free fall from

@@ -26,7 +26,7 @@ use std::time::{Duration, Instant};
 #[derive(clap::Args)]
 pub struct ViewArgs {
     /// Scenes to cycle through with TAB: built-in names, .toml scenes or .w worlds
-    /// (default: the eight built-ins).
+    /// (default: the nine built-ins).
     scenes: Vec<String>,
     /// Window size as WIDTHxHEIGHT.
     #[arg(long, default_value = "800x600", value_parser = hooke_cli::args::parse_size)]

@@ -531,3 +531,41 @@ fn a_closed_pipe_ends_the_program_quietly() {
     assert_eq!(out.status.code(), Some(141), "{}", stderr(&out));
     assert!(!stderr(&out).contains("panicked"), "{}", stderr(&out));
 }
+
+/// `hooke check` warns of a collider keyed faster than its thickness allows per step, with
+/// its speed, as it warns of a fast particle; and refuses a moving ground with its key.
+#[test]
+fn check_warns_of_a_collider_that_moves_too_fast_for_its_thickness() {
+    let dir = scratch("fast-collider");
+    let scene = |keys: &str, shape: &str| {
+        format!(
+            "name = \"puck\"\n[simulation]\nintegrator = \"symplectic\"\ndt = 0.001\nsteps = 10\nevery = 1\n\
+             [[body]]\nname = \"p\"\nmass = 0.1\n[body.shape]\nkind = \"points\"\npositions = [[0.0, 1.0, 0.0]]\n\
+             [[collider]]\nshape = {shape}\nresponse = {{ kind = \"restitution\", cr = 0.0 }}\n\
+             motion = {{ keys = {keys} }}\n"
+        )
+    };
+    let puck = "{ kind = \"cylinder\", center = [3.0, 0.5, 0.0], radius = 0.02, thickness = 0.02 }";
+    // 40 m/s against 20 mm: 40 mm per millisecond step, twice the thickness.
+    let fast =
+        "[{ t = 0.0, translate = [0.0, 0.0, 0.0] }, { t = 0.1, translate = [-4.0, 0.0, 0.0] }]";
+    std::fs::write(dir.join("fast.toml"), scene(fast, puck)).unwrap();
+    let out = hooke(&["check", "fast.toml"], &dir);
+    let text = String::from_utf8_lossy(&out.stdout).to_string() + &stderr(&out);
+    assert!(
+        text.contains("moving cylinder") && text.contains("the collider moves at up to 40.00 m/s"),
+        "{text}"
+    );
+    std::fs::write(
+        dir.join("ground.toml"),
+        scene(fast, "{ kind = \"ground\", height = 0.0 }"),
+    )
+    .unwrap();
+    let out = hooke(&["check", "ground.toml"], &dir);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("collider[0].motion") && stderr(&out).contains("cannot move"),
+        "{}",
+        stderr(&out)
+    );
+}

@@ -423,3 +423,90 @@ fn export_paths_that_make_no_sense_are_refused_before_the_run() {
     assert!(file_names(&dir).is_empty(), "{:?}", file_names(&dir));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A moving collider's USD prim carries its pose as time samples: read back with `pxr`, the
+/// puck keyed 1.4 m along x (and turned 90° about y) between 0.05 s and 0.15 s sits at its
+/// start in frame 0 and 1.4 m along at the last frame, its transform turned; a still
+/// collider has none. The OBJ frames hold it where it is too.
+#[test]
+fn a_moving_collider_is_time_sampled_in_usd_and_posed_in_obj_frames() {
+    let Some(python) = python() else { return };
+    let dir = scratch("export-moving");
+    let scene = "name = \"puck\"\n[simulation]\nintegrator = \"symplectic\"\ndt = 0.001\nsteps = 200\nevery = 50\n\
+                 [[body]]\nname = \"p\"\nmass = 0.1\n[body.shape]\nkind = \"points\"\npositions = [[0.0, 3.0, 0.0]]\n\
+                 [[collider]]\nshape = { kind = \"ground\", height = 0.0 }\nresponse = { kind = \"stick\" }\n\
+                 [[collider]]\nshape = { kind = \"cylinder\", center = [-1.0, 0.5, 0.0], radius = 0.2, thickness = 0.2 }\n\
+                 response = { kind = \"restitution\", cr = 0.0 }\n\
+                 motion = { keys = [{ t = 0.05, translate = [0.0, 0.0, 0.0] }, { t = 0.15, translate = [1.4, 0.0, 0.0], rotate = [0.0, 90.0, 0.0] }] }\n";
+    std::fs::write(dir.join("puck.toml"), scene).unwrap();
+    run(&["run", "puck.toml", "--export", "puck.usda"], &dir);
+    let script = r#"
+import sys
+from pxr import Usd, UsdGeom
+stage = Usd.Stage.Open(sys.argv[1])
+puck = stage.GetPrimAtPath("/World/colliders/c1_cylinder")
+ground = stage.GetPrimAtPath("/World/colliders/c0_ground")
+first, last = stage.GetStartTimeCode(), stage.GetEndTimeCode()
+xf = UsdGeom.Xformable(puck)
+m0 = xf.ComputeLocalToWorldTransform(first)
+m1 = xf.ComputeLocalToWorldTransform(last)
+# The puck's pivot (-1, 0.5, 0) is carried to (0.4, 0.5, 0); the x axis turned to -z.
+p0 = m0.Transform((-1.0, 0.5, 0.0))
+p1 = m1.Transform((-1.0, 0.5, 0.0))
+x1 = m1.TransformDir((1.0, 0.0, 0.0))
+print("start %.9f %.9f %.9f" % tuple(p0))
+print("end %.9f %.9f %.9f" % tuple(p1))
+print("xaxis %.9f %.9f %.9f" % tuple(x1))
+print("ground samples", len(UsdGeom.Xformable(ground).GetOrderedXformOps()))
+"#;
+    let out = Command::new(&python)
+        .args(["-c", script])
+        .arg(dir.join("puck.usda"))
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("start -1.000000000 0.500000000 0.000000000"),
+        "{text}"
+    );
+    assert!(
+        text.contains("end 0.400000000 0.500000000 0.000000000"),
+        "{text}"
+    );
+    assert!(
+        text.contains("xaxis 0.000000000 0.000000000 -1.000000000"),
+        "{text}"
+    );
+    assert!(text.contains("ground samples 0"), "{text}");
+    // OBJ: the puck's vertices at the last frame are 1.4 m along from the first frame's.
+    run(
+        &["run", "puck.toml", "--export", "frames/", "--format", "obj"],
+        &dir,
+    );
+    let mean_x = |f: &str| {
+        let text = std::fs::read_to_string(dir.join("frames").join(f)).unwrap();
+        let mut in_puck = false;
+        let xs: Vec<f64> = text
+            .lines()
+            .filter_map(|l| {
+                if l.starts_with("o ") {
+                    in_puck = l.contains("cylinder");
+                }
+                let v = l.strip_prefix("v ").filter(|_| in_puck)?;
+                v.split(' ').next()?.parse().ok()
+            })
+            .collect();
+        xs.iter().sum::<f64>() / xs.len() as f64
+    };
+    let moved = mean_x("frame-00004.obj") - mean_x("frame-00000.obj");
+    assert!(
+        (moved - 1.4).abs() < 1e-9,
+        "the exported puck moved {moved} m"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

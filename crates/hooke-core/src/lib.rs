@@ -48,10 +48,12 @@ mod simulation;
 
 // Small tools every area may use.
 mod excerpt;
+mod keyframes;
 mod number;
 mod parallel;
 
 pub use assembly::kernel::Kernel;
+pub use collider::moving::Moving;
 pub use collider::response::Response;
 pub use collider::{Circle, Collider, Contact, Feature};
 pub use contact::ContactStats;
@@ -60,7 +62,8 @@ pub use forces::air::{AeroSurface, Air, Gust};
 pub use forces::field::ForceField;
 pub use forces::spring::{Spring, SpringKind};
 pub use integrator::{Integrator, UnknownIntegrator};
-pub use model::motion::{Key, KeyError, Keyframes, PinMotion};
+pub use keyframes::{Key, KeyError, Keyframes};
+pub use model::motion::PinMotion;
 pub use model::surface::{DEFAULT_CLOTH_THICKNESS, DEFAULT_SURFACE_FRICTION, Surface};
 pub use model::{Attachment, ColliderSlot, Model};
 pub use number::Num;

@@ -70,6 +70,7 @@ fn shipped_mesh(path: &str, response: ResponseSpec) -> ColliderSpec {
             scale: [Positive::of(1.0); 3],
         },
         response,
+        motion: None,
     }
 }
 
@@ -82,6 +83,7 @@ fn ground(cr: f64, friction: f64) -> ColliderSpec {
             cr: Fraction::of(cr),
             friction: NonNegative::of(friction),
         },
+        motion: None,
     }
 }
 
@@ -346,6 +348,7 @@ pub fn flag() -> SceneSpec {
                     cr: Fraction::of(0.0),
                     friction: NonNegative::of(0.3),
                 },
+                motion: None,
             },
         ],
         force_field: None,
@@ -402,12 +405,45 @@ pub fn tablecloth() -> SceneSpec {
     }
 }
 
+/// `hanging-cloth` with a moving collider (docs/physics.md §2.1): a puck (a cylinder 0.3 m
+/// across and 0.4 m tall, Coulomb friction 0.3) keyed through the hanging cloth at 0.7 m/s
+/// from 2 s to 4 s, turning a quarter about the vertical on the way; the cloth is pushed
+/// aside and swings back.
+pub fn puck_sweep() -> SceneSpec {
+    let mut spec = hanging_cloth();
+    spec.name = "puck-sweep".into();
+    spec.description =
+        "the hanging cloth with a puck keyed through it (a moving collider); pushed aside, it swings back"
+            .into();
+    spec.simulation.duration = Some(Positive::of(5.0));
+    let key = |t: f64, x: f64, turn: f64| KeySpec {
+        t: Finite::of(t),
+        translate: f3([x, 0.0, 0.0]),
+        rotate: Some(f3([0.0, turn, 0.0])),
+    };
+    spec.colliders.push(ColliderSpec {
+        shape: ColliderShapeSpec::Cylinder {
+            center: f3([-1.5, 1.7, 0.0]),
+            radius: Positive::of(0.15),
+            thickness: Positive::of(0.4),
+        },
+        response: ResponseSpec::Restitution {
+            cr: Fraction::of(0.0),
+            friction: NonNegative::of(0.3),
+        },
+        motion: Some(MotionSpec {
+            keys: vec![key(2.0, 0.0, 0.0), key(4.0, 1.4, 90.0)],
+        }),
+    });
+    spec
+}
+
 /// Makes a built-in scene.
 pub type Maker = fn() -> SceneSpec;
 
 /// The built-in scenes by name: the course document's five, then the contact scene, the
-/// air scene and the material tablecloth.
-pub const BUILTINS: [(&str, Maker); 8] = [
+/// air scene, the material tablecloth and the moving puck.
+pub const BUILTINS: [(&str, Maker); 9] = [
     ("single-spring", single_spring),
     ("chain", chain),
     ("jello-cube", jello_cube),
@@ -416,6 +452,7 @@ pub const BUILTINS: [(&str, Maker); 8] = [
     ("cloth-pile", cloth_pile),
     ("flag", flag),
     ("tablecloth", tablecloth),
+    ("puck-sweep", puck_sweep),
 ];
 
 /// The built-in scene called `name`.

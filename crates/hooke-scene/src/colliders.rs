@@ -56,6 +56,26 @@ fn mesh_text(path: &str, base: &Path) -> Result<(String, PathBuf), MeshError> {
     Ok((text, full))
 }
 
+/// `shape` moved by `motion` about its pivot: a mesh's placed origin (`translate`), a
+/// box's or a cylinder's centre. A ground or a plane cannot move.
+pub(crate) fn moving(
+    shape: Box<dyn Collider>,
+    spec: &ColliderShapeSpec,
+    motion: &crate::spec::MotionSpec,
+    key: &str,
+) -> Result<Box<dyn Collider>, BuildError> {
+    let Some(pivot) = spec.pivot() else {
+        return Err(invalid(
+            format!("{key}.motion"),
+            "a ground or a plane cannot move: only a mesh, a box or a cylinder can",
+        ));
+    };
+    let keys = motion
+        .keyframes()
+        .map_err(|e| invalid(format!("{key}.motion.keys"), e.to_string()))?;
+    Ok(Box::new(hooke_core::Moving::new(shape, pivot, keys)))
+}
+
 pub(crate) fn build_collider(
     shape: &ColliderShapeSpec,
     key: &str,

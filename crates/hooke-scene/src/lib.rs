@@ -4,8 +4,8 @@
 //!   [`load_scene`], written by [`to_toml`];
 //! * generators for chains, cloth grids and jelly lattices with structural, shear and bend
 //!   springs ([`generators`]);
-//! * the eight built-in scenes ([`builtin`]): the course's five, `cloth-pile`, `flag` and
-//!   the material `tablecloth`;
+//! * the nine built-in scenes ([`builtin`]): the course's five, `cloth-pile`, `flag`, the
+//!   material `tablecloth` and the moving `puck-sweep`;
 //! * building a ready-to-step [`Scene`] from a description ([`SceneSpec::build`]).
 //!
 //! ```
@@ -43,6 +43,6 @@ pub use colliders::BUILTIN_MESHES;
 pub use error::BuildError;
 pub use limits::{MAX_PARTICLES, MAX_STEPS};
 pub use overrides::{Overrides, TableOverride};
-pub use scene::{Body, ColliderGeometry, Scene, Topology};
+pub use scene::{Body, ColliderGeometry, ColliderPose, Scene, Topology};
 pub use scene_toml::{SceneError, load_scene, parse_scene, to_toml};
 pub use spec::SceneSpec;

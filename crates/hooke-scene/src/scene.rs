@@ -68,3 +68,45 @@ pub struct Scene {
     /// collider (see [`hooke_core::Simulation::push_out_start`]); said as warnings.
     pub pushed_out: Vec<hooke_core::PushedOut>,
 }
+
+/// Where a moving collider is at some time: `x ↦ pivot + translate + R (x − pivot)`, with
+/// `R` the rotation by `rotate` (degrees about x, then y, then z; docs/physics.md §2.1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ColliderPose {
+    /// The point it turns about, metres.
+    pub pivot: Vec3,
+    /// Its translation from where the scene placed it, metres.
+    pub translate: Vec3,
+    /// Its rotation, degrees about x, then y, then z.
+    pub rotate: Vec3,
+    rotation: nalgebra::Rotation3<f64>,
+}
+
+impl ColliderPose {
+    /// Where the point `p` of the collider as placed in the scene is now.
+    pub fn place(&self, p: &Vec3) -> Vec3 {
+        self.pivot + self.translate + self.rotation * (p - self.pivot)
+    }
+}
+
+impl Scene {
+    /// The pose of collider `k` at time `t` (seconds), or `None` when it does not move.
+    pub fn collider_pose(&self, k: usize, t: f64) -> Option<ColliderPose> {
+        let spec = self.spec.colliders.get(k)?;
+        let keys = spec.motion.as_ref()?.keyframes().ok()?;
+        let pivot = spec.shape.pivot()?;
+        let (translate, rotate) = keys.at(t);
+        let (rotation, _) = keys.pose(t);
+        Some(ColliderPose {
+            pivot,
+            translate,
+            rotate,
+            rotation,
+        })
+    }
+
+    /// Whether some collider moves.
+    pub fn has_moving_colliders(&self) -> bool {
+        self.spec.colliders.iter().any(|c| c.motion.is_some())
+    }
+}

@@ -394,6 +394,20 @@ pub struct KeySpec {
     pub rotate: Option<[Finite; 3]>,
 }
 
+impl ColliderShapeSpec {
+    /// The point a collider turns about when it moves: a mesh's placed origin
+    /// (`translate`), a box's or a cylinder's centre; `None` for a ground or a plane, which
+    /// cannot move.
+    pub fn pivot(&self) -> Option<Vec3> {
+        match self {
+            Self::Mesh { translate, .. } => Some(vec3(translate)),
+            Self::Box { min, max } => Some((vec3(min) + vec3(max)) / 2.0),
+            Self::Cylinder { center, .. } => Some(vec3(center)),
+            Self::Ground { .. } | Self::Plane { .. } => None,
+        }
+    }
+}
+
 impl MotionSpec {
     /// The keys as the core's, checked (at least one, times increasing).
     pub fn keyframes(&self) -> Result<hooke_core::Keyframes, hooke_core::KeyError> {
@@ -461,6 +475,10 @@ pub struct ColliderSpec {
     pub shape: ColliderShapeSpec,
     /// What it does to particles that violate it.
     pub response: ResponseSpec,
+    /// Keys that move a mesh, box or cylinder rigidly about its placed origin or centre
+    /// (docs/physics.md §2.1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<MotionSpec>,
 }
 
 /// A collider's geometry.

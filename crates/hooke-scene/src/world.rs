@@ -378,6 +378,7 @@ impl World {
                 max: [Finite::of(2.0); 3],
             },
             response: penalty,
+            motion: None,
         }];
         if let Some(c) = self.plane {
             let mut coefficients = [Finite::of(0.0); 4];
@@ -387,6 +388,7 @@ impl World {
             colliders.push(ColliderSpec {
                 shape: ColliderShapeSpec::Plane { coefficients },
                 response: penalty,
+                motion: None,
             });
         }
         let field = finite_list("forceField", &self.field)?;
@@ -490,6 +492,9 @@ impl World {
             let ResponseSpec::Penalty { kc, dc } = c.response else {
                 return no("jello colliders are penalty springs");
             };
+            if c.motion.is_some() {
+                return no("jello colliders do not move");
+            }
             if penalty.is_some_and(|p| p != (kc.get(), dc.get())) {
                 return no("all colliders must share kCollision and dCollision");
             }

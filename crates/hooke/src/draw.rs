@@ -271,7 +271,16 @@ pub fn draw_with(scene: &Scene, style: Style, show: impl Fn(SpringKind) -> bool)
     }
     let body_bounds = list.bounds();
     let mut box_bounds = None;
-    for c in &scene.colliders {
+    let t = scene.simulation.time();
+    for (k, c) in scene.colliders.iter().enumerate() {
+        // A moving collider is drawn as its triangles where it is now.
+        if let Some(pose) = scene.collider_pose(k, t) {
+            let half = (Vec3::zeros(), Vec3::zeros());
+            for tri in c.triangles(Vec3::zeros(), 0.0, half) {
+                list.flat(tri.map(|p| pose.place(&p)), TABLE);
+            }
+            continue;
+        }
         match c {
             // Drawn where they are: contacts keep cloth a thickness away from them.
             ColliderGeometry::Mesh(tris) => tris.iter().for_each(|t| list.flat(*t, TABLE)),

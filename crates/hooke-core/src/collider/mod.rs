@@ -1,5 +1,6 @@
 //! The `Collider` trait the core owns; concrete shapes live in `hooke-collide`.
 
+pub(crate) mod moving;
 pub(crate) mod response;
 
 use crate::particles::Vec3;
@@ -111,6 +112,31 @@ pub trait Collider: Debug + Send + Sync {
     /// there. `None` for half-spaces and for open sheets (which the crossing test guards).
     fn thickness(&self) -> Option<f64> {
         None
+    }
+
+    /// Takes the collider's pose for a step from `t0` to `t1` (seconds): queries answer at
+    /// `t1`, and [`Collider::velocity`] and [`Collider::carried`] over the step. Still
+    /// colliders ignore it, the default.
+    fn advance_to(&mut self, t0: f64, t1: f64) {
+        let _ = (t0, t1);
+    }
+
+    /// Whether the collider moves (then callers may not cache what it answered).
+    fn is_moving(&self) -> bool {
+        false
+    }
+
+    /// The velocity over the current step of the collider's material point now at `p`
+    /// (zero for a still collider).
+    fn velocity(&self, p: &Vec3) -> Vec3 {
+        let _ = p;
+        Vec3::zeros()
+    }
+
+    /// Where the collider's material point that was at `p` at the step's start is at its
+    /// end (`p` itself for a still collider).
+    fn carried(&self, p: &Vec3) -> Vec3 {
+        *p
     }
 
     /// Whether `p` is inside.

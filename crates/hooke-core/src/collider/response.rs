@@ -45,34 +45,48 @@ impl Response {
         }
     }
 
-    /// Applies a velocity-level response for one contact to a particle, in place; `x0` is
-    /// where the particle started the step.
+    /// Applies a velocity-level response for one contact to a particle, in place. `start` is
+    /// where the particle started the step, carried along by the collider, and `u` the
+    /// collider's velocity at the contact ([`crate::Collider::carried`],
+    /// [`crate::Collider::velocity`]: `x0` and zero for a still collider): the response acts
+    /// on the velocity and the step's motion relative to the collider.
     ///
     /// The particle moves by `δ n` rather than to `contact.point` so that several contacts of
     /// one collider (the faces at a box corner) compose into the nearest point of all of them.
     /// Friction acts within the step: the share of the tangential velocity it takes off is
     /// also taken off the step's tangential displacement, so a contact that sticks does not
     /// creep by the one step's slide that came before the response.
-    pub fn respond(&self, contact: &Contact, x0: &Vec3, x: &mut Vec3, v: &mut Vec3) {
+    pub fn respond(
+        &self,
+        contact: &Contact,
+        (start, u): (&Vec3, &Vec3),
+        x: &mut Vec3,
+        v: &mut Vec3,
+    ) {
         match *self {
             Self::Penalty { .. } => {}
             Self::Restitution { cr, friction } => {
                 let n = contact.normal;
                 *x += n * contact.depth;
-                let vn = v.dot(&n);
+                let relative = *v - u;
+                let vn = relative.dot(&n);
                 if vn < 0.0 {
-                    let tangential = *v - n * vn;
+                    let tangential = relative - n * vn;
                     let cut = coulomb_cut(friction, -(1.0 + cr) * vn, &tangential);
                     *v = tangential - tangential * cut + n * (-cr * vn);
+                    // Added only for a moving collider: `-0 + 0` would flip a sign bit.
+                    if *u != Vec3::zeros() {
+                        *v += u;
+                    }
                     if cut > 0.0 {
-                        let moved = *x - x0;
+                        let moved = *x - start;
                         *x -= (moved - n * n.dot(&moved)) * cut;
                     }
                 }
             }
             Self::Stick => {
                 *x += contact.normal * contact.depth;
-                *v = Vec3::zeros();
+                *v = *u;
             }
         }
     }

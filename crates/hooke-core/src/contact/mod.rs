@@ -86,6 +86,9 @@ struct Stencil {
     len: usize,
     /// The collider's point (zero for surface pairs).
     anchor: Vec3,
+    /// The collider's velocity at `anchor` over the step (zero for surface pairs and still
+    /// colliders).
+    anchor_velocity: Vec3,
     /// The gap's unit normal.
     n: Vec3,
     /// The gap to keep, metres.
@@ -101,6 +104,7 @@ impl Stencil {
             w,
             len: 4,
             anchor: Vec3::zeros(),
+            anchor_velocity: Vec3::zeros(),
             n: Vec3::zeros(),
             h,
             rule: Rule::Coulomb(mu),
@@ -168,6 +172,8 @@ struct FeaturePair {
     tri: u32,
     feature: Feature,
     rule: Rule,
+    /// The collider's index (for its velocity).
+    collider: u16,
 }
 
 /// The contact phase's topology, candidate lists and buffers, kept from step to step.
@@ -217,7 +223,7 @@ pub(crate) struct ContactState {
     feature_pairs: Vec<FeaturePair>,
     /// Boxes and grids at the last build.
     bins: Bins,
-    features: Vec<(Feature, Rule)>,
+    features: Vec<(Feature, Rule, u16)>,
     active: Vec<Stencil>,
     /// Per-chunk buffers of the parallel detection and candidate builds.
     scratch: Vec<Vec<Stencil>>,
@@ -284,8 +290,13 @@ impl ContactState {
             }) / n;
             self.drift2(x, &self.self_ref, mean) > limit
         };
-        let features_stale =
-            self.feature_ref.is_empty() || self.drift2(x, &self.feature_ref, Vec3::zeros()) > limit;
+        // A moving collider's features are where it is now: found anew every step.
+        let features_stale = self.feature_ref.is_empty()
+            || model
+                .colliders
+                .iter()
+                .any(|c| c.shape.is_moving() && c.shape.has_features())
+            || self.drift2(x, &self.feature_ref, Vec3::zeros()) > limit;
         if !(self_stale || features_stale) {
             return;
         }
@@ -363,13 +374,16 @@ impl ContactState {
             (self.bins.tri_box[0].0, self.bins.tri_box[0].1),
             |(lo, hi), b| (lo.inf(&b.0), hi.sup(&b.1)),
         );
-        for slot in model.colliders.iter().filter(|c| c.shape.has_features()) {
+        for (k, slot) in model.colliders.iter().enumerate() {
+            if !slot.shape.has_features() {
+                continue;
+            }
             let rule = Rule::of(&slot.response);
             let features = &mut self.features;
             slot.shape
-                .features(&lo, &hi, &mut |f| features.push((f, rule)));
+                .features(&lo, &hi, &mut |f| features.push((f, rule, k as u16)));
         }
-        for &(feature, rule) in &self.features {
+        for &(feature, rule, collider) in &self.features {
             let (flo, fhi) = feature.bounds();
             let (c0, c1) = (
                 self.bins.tri_grid.cell_of(&flo),
@@ -389,6 +403,7 @@ impl ContactState {
                                     tri: t,
                                     feature,
                                     rule,
+                                    collider,
                                 });
                             }
                         });
@@ -453,11 +468,13 @@ impl ContactState {
             let t = self.tris[pair.tri as usize];
             let h = self.margin[t[0] as usize];
             if let Some((anchor, w)) = feature_gap(&pair.feature, &t, x, h) {
+                let shape = &model.colliders[pair.collider as usize].shape;
                 let s = Stencil {
                     ids: [t[0], t[1], t[2], 0],
                     w: [w[0], w[1], w[2], 0.0],
                     len: 3,
                     anchor,
+                    anchor_velocity: shape.velocity(&anchor),
                     n: Vec3::zeros(),
                     h,
                     rule: pair.rule,
@@ -934,7 +951,11 @@ pub(crate) fn phase(
             if c == 0.0 {
                 continue;
             }
-            let u = s.gap(&p.v) + s.anchor;
+            // The gap's velocity: the stencil's, less the collider point's.
+            let mut u = s.gap(&p.v) + s.anchor;
+            if s.anchor_velocity != Vec3::zeros() {
+                u -= s.anchor_velocity;
+            }
             let un = u.dot(&s.n);
             let ut = u - s.n * un;
             let du = match s.rule {

@@ -147,22 +147,28 @@ pub(crate) fn respond_one(
         .filter(|c| !c.response.is_force())
         .enumerate()
     {
-        let tracked = c < FACE_SKIP_COLLIDERS;
+        // A moving collider's clearance says nothing about the next step.
+        let tracked = c < FACE_SKIP_COLLIDERS && !slot.shape.is_moving();
         if tracked && skip.as_ref().is_some_and(|s| s.path < s.budget[c]) {
             continue;
         }
         let here = *x;
         let mut touched = false;
+        // The particle's start carried along by the collider: what the step's motion
+        // relative to it is measured from (the start itself for a still collider).
+        let start = slot.shape.carried(x0);
         let mut apply = |c: Contact| {
             touched = true;
-            slot.response.respond(&c, x0, x, v);
+            let u = slot.shape.velocity(&c.point);
+            slot.response.respond(&c, (&start, &u), x, v);
         };
         // With no margin this is `contacts`, the Collider contract says.
         slot.shape.contacts_within(&here, margin, &mut apply);
         if !touched && let Some(mut c) = slot.shape.crossing(x0, &here) {
             touched = true;
             c.depth += margin;
-            slot.response.respond(&c, x0, x, v);
+            let u = slot.shape.velocity(&c.point);
+            slot.response.respond(&c, (&start, &u), x, v);
         }
         held |= touched && matches!(slot.response, Response::Stick);
         if let Some(skip) = skip.as_deref_mut()

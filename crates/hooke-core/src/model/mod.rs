@@ -221,7 +221,14 @@ impl Model {
             if slot.response.is_force() && near.may_touch(k) {
                 let m = *margin.get_or_insert_with(|| self.margin(p));
                 slot.shape.contacts_within(x, m, &mut |c: Contact| {
-                    f += slot.response.penalty_force(&c, v)
+                    // Damping acts on the velocity relative to a moving collider.
+                    if slot.shape.is_moving() {
+                        f += slot
+                            .response
+                            .penalty_force(&c, &(v - slot.shape.velocity(&c.point)))
+                    } else {
+                        f += slot.response.penalty_force(&c, v)
+                    }
                 });
             }
         }

@@ -259,6 +259,9 @@ impl Simulation {
     /// [`Simulation::step`] on the current thread.
     fn step_here(&mut self) -> Result<(), Divergence> {
         let time = self.time();
+        for slot in &mut self.model.colliders {
+            slot.shape.advance_to(time, time + self.dt);
+        }
         self.start_pins(time);
         let report = self.integrator.step(
             &self.model,

@@ -230,7 +230,8 @@ pub fn shape(body: &Body) -> Shape<'_> {
 /// reach.
 const GROUND_HALF: f64 = 2.5;
 
-/// Each collider's name (`<index>-<kind>`) and surface as triangles, which do not move: the
+/// Each collider's name (`<index>-<kind>`) and surface as triangles where the scene placed
+/// it (see [`posed`] for moving ones): the
 /// analytic cylinder tessellated inside the true solid, the ground a square around the
 /// bodies' start, an inclined plane clipped to the jello box or a region around the bodies.
 pub fn collider_triangles(scene: &Scene) -> Vec<(String, Vec<[Vec3; 3]>)> {
@@ -264,6 +265,26 @@ pub fn collider_triangles(scene: &Scene) -> Vec<(String, Vec<[Vec3; 3]>)> {
                 format!("{k}-{}", c.kind()),
                 c.triangles(centre, GROUND_HALF, region),
             )
+        })
+        .collect()
+}
+
+/// `colliders` (as [`collider_triangles`] gives them, in scene order) with each moving one
+/// at its pose at the scene's current time.
+pub fn posed(
+    scene: &Scene,
+    colliders: &[(String, Vec<[Vec3; 3]>)],
+) -> Vec<(String, Vec<[Vec3; 3]>)> {
+    let t = scene.simulation.time();
+    colliders
+        .iter()
+        .enumerate()
+        .map(|(k, (name, tris))| match scene.collider_pose(k, t) {
+            Some(pose) => (
+                name.clone(),
+                tris.iter().map(|tri| tri.map(|p| pose.place(&p))).collect(),
+            ),
+            None => (name.clone(), tris.clone()),
         })
         .collect()
 }

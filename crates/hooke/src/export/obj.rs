@@ -23,7 +23,8 @@ pub struct ObjExport {
     _lock: crate::output::lock::FolderLock,
     /// Frames written.
     frames: u64,
-    /// `collider:<index>-<kind>` and its triangles, which do not move.
+    /// `collider:<index>-<kind>` and its triangles where the scene placed it (moving ones
+    /// are posed at each frame's time).
     colliders: Vec<(String, Vec<[Vec3; 3]>)>,
 }
 
@@ -124,7 +125,14 @@ impl crate::Sink for ObjExport {
     fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
         let path = self.path(frame);
         let mut file = OutputFile::create_named(&path, "--export")?;
-        write_frame(file.writer(), frame, scene, &self.colliders)
+        let posed;
+        let colliders = if scene.has_moving_colliders() {
+            posed = super::posed(scene, &self.colliders);
+            &posed
+        } else {
+            &self.colliders
+        };
+        write_frame(file.writer(), frame, scene, colliders)
             .with_context(|| format!("cannot write {}", path.display()))?;
         file.commit()?;
         self.frames += 1;

@@ -12,8 +12,9 @@
 //! * a chain is a linear `BasisCurves` through its particles, time-sampled the same way;
 //! * loose particles are `Points`.
 //!
-//! A body's points are its particles in order. The colliders are static meshes under
-//! `/World/colliders` (see [`super::collider_triangles`]). Positions and velocities are
+//! A body's points are its particles in order. The colliders are meshes under
+//! `/World/colliders` where the scene placed them (see [`super::collider_triangles`]); a
+//! moving one has a time-sampled `xformOp:transform` with its pose at each frame. Positions and velocities are
 //! `float` as the schemas declare them, each the `f32` nearest the simulation's `f64`.
 //!
 //! A time-sampled attribute holds all its frames in one block, so the frames cannot go
@@ -94,8 +95,10 @@ pub struct UsdExport {
     path: PathBuf,
     scene: String,
     bodies: Vec<BodyStream>,
-    /// The static colliders' prims.
-    colliders: String,
+    /// The colliders' prims, each a `{transform}` slot where a moving one's samples go.
+    colliders: Vec<String>,
+    /// Per collider: its `xformOp:transform` samples so far (empty for a still one).
+    transforms: Vec<String>,
     frames: u64,
     /// Seconds between frames.
     frame_time: f64,
@@ -127,6 +130,7 @@ impl UsdExport {
             scene: scene.spec.name.clone(),
             bodies,
             colliders: colliders(scene)?,
+            transforms: vec![String::new(); scene.colliders.len()],
             frames: 0,
             frame_time: scene.every as f64 * scene.simulation.dt(),
         })
@@ -165,8 +169,20 @@ impl UsdExport {
             }
             writeln!(file.writer(), "    }}")?;
         }
-        file.writer().write_all(self.colliders.as_bytes())?;
-        writeln!(file.writer(), "}}")?;
+        writeln!(file.writer(), "    def Xform \"colliders\"\n    {{")?;
+        for (prim, samples) in self.colliders.iter().zip(&self.transforms) {
+            let transform = if samples.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "            matrix4d xformOp:transform.timeSamples = {{\n{samples}            }}\n\
+                     \x20           uniform token[] xformOpOrder = [\"xformOp:transform\"]\n"
+                )
+            };
+            file.writer()
+                .write_all(prim.replace("{transform}", &transform).as_bytes())?;
+        }
+        writeln!(file.writer(), "    }}\n}}")?;
         Ok(())
     }
 }
@@ -217,11 +233,12 @@ fn opening(prim: &str, body: &hooke_scene::Body) -> Result<String> {
     Ok(s)
 }
 
-/// The colliders' static meshes, under `colliders`.
-fn colliders(scene: &Scene) -> Result<String> {
-    let mut s = String::new();
-    writeln!(s, "    def Xform \"colliders\"\n    {{")?;
+/// The colliders' meshes where the scene placed them, one prim each, for `colliders`; a
+/// moving one's transform samples go in its `{transform}` slot.
+fn colliders(scene: &Scene) -> Result<Vec<String>> {
+    let mut out = Vec::new();
     for (name, triangles) in super::collider_triangles(scene) {
+        let mut s = String::new();
         writeln!(
             s,
             "        def Mesh \"{}\"\n        {{",
@@ -247,10 +264,26 @@ fn colliders(scene: &Scene) -> Result<String> {
             s,
             "            color3f[] primvars:displayColor = [{colour}]"
         )?;
+        s.push_str("{transform}");
         writeln!(s, "        }}")?;
+        out.push(s);
     }
-    writeln!(s, "    }}")?;
-    Ok(s)
+    Ok(out)
+}
+
+/// A moving collider's pose as USD's row-vector matrix: `p' = p M`, so the rotation is
+/// transposed and the translation `pivot + T − R pivot` is the last row.
+fn pose_matrix(pose: &hooke_scene::ColliderPose) -> String {
+    let origin = pose.place(&Vec3::zeros());
+    let axes = [Vec3::x(), Vec3::y(), Vec3::z()].map(|e| pose.place(&e) - origin);
+    let row = |v: Vec3, w: u8| format!("({}, {}, {}, {w})", Num(v.x), Num(v.y), Num(v.z));
+    format!(
+        "({}, {}, {}, {})",
+        row(axes[0], 0),
+        row(axes[1], 0),
+        row(axes[2], 0),
+        row(origin, 1)
+    )
 }
 
 impl crate::Sink for UsdExport {
@@ -291,6 +324,12 @@ impl crate::Sink for UsdExport {
                 )
             })()
             .with_context(|| format!("cannot write the samples of {}", self.path.display()))?;
+        }
+        let t = scene.simulation.time();
+        for (k, samples) in self.transforms.iter_mut().enumerate() {
+            if let Some(pose) = scene.collider_pose(k, t) {
+                let _ = writeln!(samples, "                {frame}: {},", pose_matrix(&pose));
+            }
         }
         self.frames += 1;
         Ok(())

@@ -15,7 +15,7 @@ use serde::Serialize;
 use std::path::Path;
 
 /// The golden stills of `golden/`, built into the binary so the report needs no checkout.
-const GOLDEN: [(&str, &[u8]); 8] = [
+const GOLDEN: [(&str, &[u8]); 9] = [
     (
         "single-spring",
         include_bytes!("../../../../golden/single-spring.png"),
@@ -41,6 +41,10 @@ const GOLDEN: [(&str, &[u8]); 8] = [
     (
         "tablecloth",
         include_bytes!("../../../../golden/tablecloth.png"),
+    ),
+    (
+        "puck-sweep",
+        include_bytes!("../../../../golden/puck-sweep.png"),
     ),
 ];
 
@@ -204,7 +208,7 @@ fn check(name: &str, golden: &[u8], files: &mut Pending) -> Result<SceneCheck> {
     })
 }
 
-/// The scenes checked: all eight, or the quick ones.
+/// The scenes checked: all nine, or the quick ones.
 pub(crate) fn names(quick: bool) -> Vec<&'static str> {
     GOLDEN
         .iter()

@@ -1,0 +1,182 @@
+//! A collider that follows keys (docs/physics.md §2.1): any still shape, answered in its own
+//! frame. A query at `p` maps `p` into the shape's frame at the step's end, asks the shape,
+//! and maps the answer back; a step's crossing test maps its start through the pose at the
+//! step's start and its end through the pose at the end, so the shape sees the particle's
+//! path relative to itself.
+
+use crate::collider::{Circle, Collider, Contact, Feature};
+use crate::keyframes::Keyframes;
+use crate::particles::Vec3;
+use nalgebra::Rotation3;
+
+/// A rigid pose: `x ↦ pivot + translate + rotation (x - pivot)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Pose {
+    rotation: Rotation3<f64>,
+    translate: Vec3,
+}
+
+impl Pose {
+    fn world_of(&self, pivot: &Vec3, q: &Vec3) -> Vec3 {
+        pivot + self.translate + self.rotation * (q - pivot)
+    }
+
+    fn shape_of(&self, pivot: &Vec3, p: &Vec3) -> Vec3 {
+        pivot + self.rotation.inverse() * (p - pivot - self.translate)
+    }
+}
+
+/// A shape moved by keys about `pivot` (its placed origin or centre).
+#[derive(Debug)]
+pub struct Moving {
+    shape: Box<dyn Collider>,
+    pivot: Vec3,
+    keys: Keyframes,
+    /// Poses at the step's start and end, and the step's length.
+    before: Pose,
+    now: Pose,
+    dt: f64,
+}
+
+impl Moving {
+    /// `shape` (as placed in the scene) moved by `keys` about `pivot`, at time 0.
+    pub fn new(shape: Box<dyn Collider>, pivot: Vec3, keys: Keyframes) -> Self {
+        let start = Self::pose(&keys, 0.0);
+        Self {
+            shape,
+            pivot,
+            keys,
+            before: start,
+            now: start,
+            dt: 0.0,
+        }
+    }
+
+    fn pose(keys: &Keyframes, t: f64) -> Pose {
+        let (rotation, translate) = keys.pose(t);
+        Pose {
+            rotation,
+            translate,
+        }
+    }
+
+    /// The keys it follows.
+    pub fn keys(&self) -> &Keyframes {
+        &self.keys
+    }
+
+    /// The point it turns about.
+    pub fn pivot(&self) -> Vec3 {
+        self.pivot
+    }
+
+    fn world(&self, q: &Vec3) -> Vec3 {
+        self.now.world_of(&self.pivot, q)
+    }
+
+    fn local(&self, p: &Vec3) -> Vec3 {
+        self.now.shape_of(&self.pivot, p)
+    }
+
+    fn contact(&self, c: Contact) -> Contact {
+        Contact {
+            depth: c.depth,
+            normal: self.now.rotation * c.normal,
+            point: self.world(&c.point),
+        }
+    }
+
+    /// The shape-frame box holding the world box `lo..hi` (its corners mapped, widened by
+    /// a rounding margin so that a promise of no contact stays a promise).
+    fn local_box(&self, lo: &Vec3, hi: &Vec3) -> (Vec3, Vec3) {
+        let mut a = Vec3::repeat(f64::INFINITY);
+        let mut b = Vec3::repeat(f64::NEG_INFINITY);
+        for k in 0..8 {
+            let corner = Vec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            );
+            let q = self.local(&corner);
+            a = a.inf(&q);
+            b = b.sup(&q);
+        }
+        let slack = 1e-9 * (1.0 + a.amax().max(b.amax()));
+        (a.add_scalar(-slack), b.add_scalar(slack))
+    }
+}
+
+impl Collider for Moving {
+    fn name(&self) -> String {
+        format!("moving {}", self.shape.name())
+    }
+
+    fn contacts(&self, p: &Vec3, sink: &mut dyn FnMut(Contact)) {
+        self.shape
+            .contacts(&self.local(p), &mut |c| sink(self.contact(c)));
+    }
+
+    fn contacts_within(&self, p: &Vec3, margin: f64, sink: &mut dyn FnMut(Contact)) {
+        self.shape
+            .contacts_within(&self.local(p), margin, &mut |c| sink(self.contact(c)));
+    }
+
+    fn may_touch(&self, lo: &Vec3, hi: &Vec3, margin: f64) -> bool {
+        if lo.iter().chain(hi.iter()).any(|c| c.is_nan()) {
+            return true;
+        }
+        let (a, b) = self.local_box(lo, hi);
+        self.shape.may_touch(&a, &b, margin)
+    }
+
+    fn features(&self, lo: &Vec3, hi: &Vec3, sink: &mut dyn FnMut(Feature)) {
+        let (a, b) = self.local_box(lo, hi);
+        self.shape.features(&a, &b, &mut |f| {
+            sink(match f {
+                Feature::Segment([p, q]) => Feature::Segment([self.world(&p), self.world(&q)]),
+                Feature::Circle(c) => Feature::Circle(Circle {
+                    center: self.world(&c.center),
+                    axis: self.now.rotation * c.axis,
+                    radius: c.radius,
+                }),
+            })
+        });
+    }
+
+    fn has_features(&self) -> bool {
+        self.shape.has_features()
+    }
+
+    fn crossing(&self, from: &Vec3, to: &Vec3) -> Option<Contact> {
+        let from = self.before.shape_of(&self.pivot, from);
+        self.shape
+            .crossing(&from, &self.local(to))
+            .map(|c| self.contact(c))
+    }
+
+    fn thickness(&self) -> Option<f64> {
+        self.shape.thickness()
+    }
+
+    fn advance_to(&mut self, t0: f64, t1: f64) {
+        self.before = Self::pose(&self.keys, t0);
+        self.now = Self::pose(&self.keys, t1);
+        self.dt = t1 - t0;
+    }
+
+    fn is_moving(&self) -> bool {
+        true
+    }
+
+    fn velocity(&self, p: &Vec3) -> Vec3 {
+        if self.dt <= 0.0 {
+            return Vec3::zeros();
+        }
+        let was = self.before.world_of(&self.pivot, &self.local(p));
+        (p - was) / self.dt
+    }
+
+    fn carried(&self, p: &Vec3) -> Vec3 {
+        self.world(&self.before.shape_of(&self.pivot, p))
+    }
+}
