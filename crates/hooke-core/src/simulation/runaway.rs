@@ -7,7 +7,8 @@
 //!
 //! The total energy `E` is kinetic plus potential (springs, gravity, penalty springs), so
 //! gravity and the springs do no net work on it. What may raise it: the force field, the
-//! air and the attachments (pins held still do no work). Their work is summed from their
+//! air, the attachments and keyframed pins (pins held still do no work; a moving
+//! collider's work is not counted). Their work is summed from their
 //! power `Σ max(0, F·v)` sampled at each check, times the time since the last. A run is
 //! runaway when
 //!
