@@ -553,9 +553,7 @@ fn pin_motion(
             "it moves the body's pinned particles, and the body has none: give `pins`",
         ));
     }
-    let keys = motion
-        .keyframes()
-        .map_err(|e| invalid(format!("{key}.pin_motion.keys"), e.to_string()))?;
+    let keys = crate::colliders::keyframes(motion, &format!("{key}.pin_motion"))?;
     let mut ids: Vec<u32> = body.pins.iter().map(|&p| (start + p) as u32).collect();
     ids.sort_unstable();
     ids.dedup();

@@ -70,10 +70,19 @@ pub(crate) fn moving(
             "a ground or a plane cannot move: only a mesh, a box or a cylinder can",
         ));
     };
-    let keys = motion
-        .keyframes()
-        .map_err(|e| invalid(format!("{key}.motion.keys"), e.to_string()))?;
+    let keys = keyframes(motion, &format!("{key}.motion"))?;
     Ok(Box::new(hooke_core::Moving::new(shape, pivot, keys)))
+}
+
+/// The keys of the motion at `key` (a collider's `motion`, a body's `pin_motion`), checked;
+/// a bad one is refused as `key.keys`.
+pub(crate) fn keyframes(
+    motion: &crate::spec::MotionSpec,
+    key: &str,
+) -> Result<hooke_core::Keyframes, BuildError> {
+    motion
+        .keyframes()
+        .map_err(|e| invalid(format!("{key}.keys"), e.to_string()))
 }
 
 pub(crate) fn build_collider(

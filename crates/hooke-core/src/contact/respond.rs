@@ -154,21 +154,23 @@ pub(crate) fn respond_one(
         }
         let here = *x;
         let mut touched = false;
-        // The particle's start carried along by the collider: what the step's motion
-        // relative to it is measured from (the start itself for a still collider).
-        let start = slot.shape.carried(x0);
+        // A contact is answered relative to the collider: from the particle's start carried
+        // along by it, at its velocity there (the start and zero for a still collider);
+        // asked only when there is a contact, off the path of every particle that has none.
+        let respond = |c: &Contact, x: &mut Vec3, v: &mut Vec3| {
+            let (start, u) = (slot.shape.carried(x0), slot.shape.velocity(&c.point));
+            slot.response.respond(c, (&start, &u), x, v);
+        };
         let mut apply = |c: Contact| {
             touched = true;
-            let u = slot.shape.velocity(&c.point);
-            slot.response.respond(&c, (&start, &u), x, v);
+            respond(&c, x, v);
         };
         // With no margin this is `contacts`, the Collider contract says.
         slot.shape.contacts_within(&here, margin, &mut apply);
         if !touched && let Some(mut c) = slot.shape.crossing(x0, &here) {
             touched = true;
             c.depth += margin;
-            let u = slot.shape.velocity(&c.point);
-            slot.response.respond(&c, (&start, &u), x, v);
+            respond(&c, x, v);
         }
         held |= touched && matches!(slot.response, Response::Stick);
         if let Some(skip) = skip.as_deref_mut()
