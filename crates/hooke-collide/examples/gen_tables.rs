@@ -1,4 +1,4 @@
-//! Writes the shipped table meshes: `cargo run -p hooke-collide --example gen_tables -- assets/meshes`.
+//! Writes the shipped meshes (two tables and a ball): `cargo run -p hooke-collide --example gen_tables -- assets/meshes`.
 
 use std::path::PathBuf;
 
@@ -12,6 +12,7 @@ fn main() -> std::io::Result<()> {
     for (name, text) in [
         ("table.obj", hooke_collide::table::round_table_obj()),
         ("square-table.obj", hooke_collide::table::square_table_obj()),
+        ("ball.obj", hooke_collide::table::ball_obj()),
     ] {
         let path = dir.join(name);
         std::fs::write(&path, text)?;

@@ -1,4 +1,4 @@
-//! Generators for the table meshes shipped in `assets/meshes/`.
+//! Generators for the meshes shipped in `assets/meshes/`: two tables and a ball.
 //!
 //! Re-run `cargo run -p hooke-collide --example gen_tables -- assets/meshes` after changing a
 //! dimension here; a test checks that the shipped files equal what these functions produce.
@@ -162,6 +162,90 @@ pub fn square_table_obj() -> String {
     w.text
 }
 
+/// Times the ball's icosahedron is subdivided: 1280 faces, whose flat middles lie at most
+/// 0.12 % of the radius inside the sphere.
+pub const BALL_SUBDIVISIONS: usize = 3;
+
+/// A ball of radius 1 about the origin: an icosahedron subdivided
+/// [`BALL_SUBDIVISIONS`] times, its vertices on the sphere, faces counter-clockwise from
+/// outside. Scale it to a radius with a mesh collider's `scale`.
+pub fn ball_obj() -> String {
+    let t = (1.0 + 5.0_f64.sqrt()) / 2.0;
+    let mut points: Vec<[f64; 3]> = [
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ]
+    .into_iter()
+    .map(unit)
+    .collect();
+    let mut faces: Vec<[usize; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..BALL_SUBDIVISIONS {
+        // Each edge's midpoint, made once and shared by the edge's two faces.
+        let mut middle = std::collections::HashMap::new();
+        let mut mid = |a: usize, b: usize, points: &mut Vec<[f64; 3]>| -> usize {
+            *middle.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let (p, q) = (points[a], points[b]);
+                points.push(unit([p[0] + q[0], p[1] + q[1], p[2] + q[2]]));
+                points.len() - 1
+            })
+        };
+        faces = faces
+            .iter()
+            .flat_map(|&[a, b, c]| {
+                let ab = mid(a, b, &mut points);
+                let bc = mid(b, c, &mut points);
+                let ca = mid(c, a, &mut points);
+                [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
+            })
+            .collect();
+    }
+    let mut w = ObjWriter::new("ball: radius 1 m about the origin, a subdivided icosahedron");
+    w.object("ball");
+    for [x, y, z] in &points {
+        w.vertex(*x, *y, *z);
+    }
+    for f in &faces {
+        w.face(&f.map(|i| i + 1));
+    }
+    w.text
+}
+
+fn unit([x, y, z]: [f64; 3]) -> [f64; 3] {
+    let n = (x * x + y * y + z * z).sqrt();
+    [x / n, y / n, z / n]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -187,11 +271,16 @@ mod tests {
             square_table_obj(),
             "rerun the gen_tables example"
         );
+        assert_eq!(
+            shipped("ball.obj"),
+            ball_obj(),
+            "rerun the gen_tables example"
+        );
     }
 
     #[test]
     fn every_table_part_is_a_closed_outward_solid() {
-        for text in [round_table_obj(), square_table_obj()] {
+        for text in [round_table_obj(), square_table_obj(), ball_obj()] {
             let parts = parse_obj(&text, Path::new("t.obj"), &Placement::default()).unwrap();
             for part in &parts {
                 assert_eq!(

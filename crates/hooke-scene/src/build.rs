@@ -257,13 +257,6 @@ impl SceneSpec {
             let (mut shape, geo) = build_collider(&spec.shape, &key, base, centroid, solid)?;
             if let Some(motion) = &spec.motion {
                 shape = crate::colliders::moving(shape, &spec.shape, motion, &key)?;
-                if self.simulation.integrator.0 == hooke_core::Integrator::Vbd {
-                    return Err(invalid(
-                        format!("{key}.motion"),
-                        "block descent (vbd) does not yet bound a particle against a moving \
-                         collider: use symplectic, rk4 or implicit with it",
-                    ));
-                }
             }
             slots.push(ColliderSlot {
                 shape,

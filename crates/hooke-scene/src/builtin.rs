@@ -413,7 +413,7 @@ pub fn puck_sweep() -> SceneSpec {
     let mut spec = hanging_cloth();
     spec.name = "puck-sweep".into();
     spec.description =
-        "the hanging cloth with a puck keyed through it (a moving collider); pushed aside, it swings back"
+        "the hanging cloth with a puck keyed through it (a moving collider); pushed aside, it swings back as the puck moves on"
             .into();
     spec.simulation.duration = Some(Positive::of(5.0));
     let key = |t: f64, x: f64, turn: f64| KeySpec {
@@ -432,7 +432,7 @@ pub fn puck_sweep() -> SceneSpec {
             friction: NonNegative::of(0.3),
         },
         motion: Some(MotionSpec {
-            keys: vec![key(2.0, 0.0, 0.0), key(4.0, 1.4, 90.0)],
+            keys: vec![key(2.0, 0.0, 0.0), key(4.0, 2.5, 90.0)],
         }),
     });
     spec

@@ -105,6 +105,20 @@ impl Scene {
         })
     }
 
+    /// Collider `k`'s pose at each of its keys (none when it does not move): its path,
+    /// for framing a picture that shows it wherever it goes.
+    pub fn collider_key_poses(&self, k: usize) -> Vec<ColliderPose> {
+        let keys = self
+            .spec
+            .colliders
+            .get(k)
+            .and_then(|c| c.motion.as_ref())
+            .map_or(&[][..], |m| &m.keys[..]);
+        keys.iter()
+            .filter_map(|key| self.collider_pose(k, key.t.get()))
+            .collect()
+    }
+
     /// Whether some collider moves.
     pub fn has_moving_colliders(&self) -> bool {
         self.spec.colliders.iter().any(|c| c.motion.is_some())

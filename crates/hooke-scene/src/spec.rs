@@ -517,7 +517,7 @@ pub enum ColliderShapeSpec {
         thickness: Positive,
     },
     /// A triangle mesh from an OBJ file. `path` is relative to the scene file; `builtin:NAME`
-    /// names a mesh shipped inside Hooke (`builtin:table.obj`, `builtin:square-table.obj`).
+    /// names a mesh shipped inside Hooke (`builtin:table.obj`, `builtin:square-table.obj`, and `builtin:ball.obj`, a ball of radius 1 m to scale).
     Mesh {
         /// The OBJ file.
         path: String,

@@ -313,14 +313,15 @@ pub fn draw_with(scene: &Scene, style: Style, show: impl Fn(SpringKind) -> bool)
 pub const DEFAULT_YAW_PITCH: (f64, f64) = (30.0, 22.0);
 
 /// A camera that frames the bodies and colliders (not the ground) from `yaw`, `pitch`
-/// degrees ([`DEFAULT_YAW_PITCH`] is the three-quarter view every picture starts from).
+/// degrees ([`DEFAULT_YAW_PITCH`] is the three-quarter view every picture starts from); a
+/// moving collider is framed at each of its keys' poses, so that it stays in view.
 pub fn frame_camera(scene: &Scene, yaw: f64, pitch: f64) -> Camera {
     let x = &scene.simulation.particles().x;
     let mut lo = x.iter().fold(Vec3::repeat(f64::INFINITY), |a, p| a.inf(p));
     let mut hi = x
         .iter()
         .fold(Vec3::repeat(f64::NEG_INFINITY), |a, p| a.sup(p));
-    for c in &scene.colliders {
+    for (k, c) in scene.colliders.iter().enumerate() {
         let pts: Vec<Vec3> = match c {
             ColliderGeometry::Mesh(t) => t.iter().flatten().copied().collect(),
             ColliderGeometry::Cylinder(c) => vec![
@@ -330,7 +331,11 @@ pub fn frame_camera(scene: &Scene, yaw: f64, pitch: f64) -> Camera {
             ColliderGeometry::Box(b) => vec![b.min, b.max],
             _ => vec![],
         };
-        for p in pts {
+        let poses = scene.collider_key_poses(k);
+        let placed = pts
+            .iter()
+            .flat_map(|p| poses.iter().map(move |pose| pose.place(p)));
+        for p in pts.iter().copied().chain(placed) {
             lo = lo.inf(&p);
             hi = hi.sup(&p);
         }

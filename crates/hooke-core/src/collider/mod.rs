@@ -126,6 +126,14 @@ pub trait Collider: Debug + Send + Sync {
         false
     }
 
+    /// How far at most a material point of the collider that is inside the world box
+    /// `lo..hi` at time `t0` moves by `t1` (zero for a still collider). Pure: it does not
+    /// take the pose, so a caller can try several spans before [`Collider::advance_to`].
+    fn sweep(&self, (t0, t1): (f64, f64), lo: &Vec3, hi: &Vec3) -> f64 {
+        let _ = (t0, t1, lo, hi);
+        0.0
+    }
+
     /// The velocity over the current step of the collider's material point now at `p`
     /// (zero for a still collider).
     fn velocity(&self, p: &Vec3) -> Vec3 {

@@ -26,6 +26,17 @@ impl Pose {
     }
 }
 
+/// The eight corners of the box `lo..hi`.
+fn corners(lo: &Vec3, hi: &Vec3) -> [Vec3; 8] {
+    std::array::from_fn(|k| {
+        Vec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        )
+    })
+}
+
 /// A shape moved by keys about `pivot` (its placed origin or centre).
 #[derive(Debug)]
 pub struct Moving {
@@ -91,12 +102,7 @@ impl Moving {
     fn local_box(&self, lo: &Vec3, hi: &Vec3) -> (Vec3, Vec3) {
         let mut a = Vec3::repeat(f64::INFINITY);
         let mut b = Vec3::repeat(f64::NEG_INFINITY);
-        for k in 0..8 {
-            let corner = Vec3::new(
-                if k & 1 == 0 { lo.x } else { hi.x },
-                if k & 2 == 0 { lo.y } else { hi.y },
-                if k & 4 == 0 { lo.z } else { hi.z },
-            );
+        for corner in corners(lo, hi) {
             let q = self.local(&corner);
             a = a.inf(&q);
             b = b.sup(&q);
@@ -166,6 +172,19 @@ impl Collider for Moving {
 
     fn is_moving(&self) -> bool {
         true
+    }
+
+    fn sweep(&self, (t0, t1): (f64, f64), lo: &Vec3, hi: &Vec3) -> f64 {
+        // A point at `pivot + T₀ + R₀ q` goes to `pivot + T₁ + R₁ q`: it moves at most
+        // `|T₁ - T₀| + ‖R₁ R₀ᵀ - I‖ |R₀ q|`, and `‖R - I‖ = 2 sin(θ/2)` for a turn by θ;
+        // `|R₀ q|` is largest at a corner of the box (a convex function's maximum).
+        let (a, b) = (Self::pose(&self.keys, t0), Self::pose(&self.keys, t1));
+        let turn = (b.rotation * a.rotation.inverse()).angle();
+        let reach = corners(lo, hi)
+            .iter()
+            .map(|c| (c - self.pivot - a.translate).norm())
+            .fold(0.0, f64::max);
+        (b.translate - a.translate).norm() + 2.0 * (0.5 * turn).sin() * reach
     }
 
     fn velocity(&self, p: &Vec3) -> Vec3 {

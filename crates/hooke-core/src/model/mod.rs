@@ -105,6 +105,11 @@ impl Model {
         self.has_contact_responses() || self.surfaces.iter().any(Surface::is_active)
     }
 
+    /// Whether any collider moves by keys.
+    pub(crate) fn has_moving_colliders(&self) -> bool {
+        self.colliders.iter().any(|c| c.shape.is_moving())
+    }
+
     /// The surfaces with a thickness (whose contacts are on), with their indices.
     pub(crate) fn active_surfaces(&self) -> impl Iterator<Item = (usize, &Surface)> {
         self.surfaces

@@ -10,6 +10,7 @@ pub(crate) mod runaway;
 pub(crate) mod stability;
 pub(crate) mod start;
 pub(crate) mod summary;
+mod swept;
 
 use crate::assembly::kernel::Kernel;
 use crate::contact::{self, ContactState, ContactStats};
@@ -259,17 +260,21 @@ impl Simulation {
     /// [`Simulation::step`] on the current thread.
     fn step_here(&mut self) -> Result<(), Divergence> {
         let time = self.time();
-        for slot in &mut self.model.colliders {
-            slot.shape.advance_to(time, time + self.dt);
-        }
-        self.start_pins(time);
-        let report = self.integrator.step(
-            &self.model,
-            &mut self.particles,
-            &mut self.workspace,
-            (time, self.dt),
-            &self.contacts.held,
-        );
+        let report = if self.integrator == Integrator::Vbd && self.model.has_moving_colliders() {
+            self.step_swept(time)
+        } else {
+            for slot in &mut self.model.colliders {
+                slot.shape.advance_to(time, time + self.dt);
+            }
+            self.start_pins(time, self.dt);
+            self.integrator.step(
+                &self.model,
+                &mut self.particles,
+                &mut self.workspace,
+                (time, self.dt),
+                &self.contacts.held,
+            )
+        };
         self.last = report;
         // Every scheme saves its start positions when the model has a contact phase.
         // Block descent keeps its contacts inside its own iterations.
@@ -306,10 +311,9 @@ impl Simulation {
     }
 
     /// Keyframed pins at the step's start (docs/physics.md §1.2): each where its keys put it
-    /// at `t`, moving at its keys' mean velocity over the step, which the integrators keep
+    /// at `t`, moving at its keys' mean velocity over the step of length `dt`, which the integrators keep
     /// (a pinned particle's velocity never changes) and the springs' damping reads.
-    fn start_pins(&mut self, t: f64) {
-        let dt = self.dt;
+    fn start_pins(&mut self, t: f64, dt: f64) {
         let p = &mut self.particles;
         for motion in &self.model.pin_motions {
             for ((i, now), (_, next)) in motion.positions(t).zip(motion.positions(t + dt)) {

@@ -295,7 +295,7 @@ impl Detection {
         self.touches_another.resize(graph.free_bodies.len(), false);
         for pair in &self.pairs {
             // A feature pair's other side is a collider, not a body.
-            if matches!(pair.sides, Sides::Feature(_)) {
+            if matches!(pair.sides, Sides::Feature(..)) {
                 continue;
             }
             let bodies = pair
@@ -376,7 +376,7 @@ impl Detection {
             .fold(0.0, f64::max);
         let collider_reach = (COLLIDER_REACH * h_max).max(4.0 * travel).max(1e-6);
         self.detect_colliders(model, x, collider_reach);
-        self.detect_features(model, x, collider_reach);
+        self.detect_features(model, x, collider_reach, dt);
         let surface_reach = SURFACE_REACH * h_max;
         self.detect_surfaces(model, x, surface_reach);
         self.index_pairs(n, p);
@@ -449,8 +449,9 @@ impl Detection {
     }
 
     /// Per surface triangle: the nearest sharp collider feature (capped at `reach`), and the
-    /// feature pairs it may touch before the next detection.
-    fn detect_features(&mut self, model: &Model, x: &[Vec3], reach: f64) {
+    /// feature pairs it may touch before the next detection, with how far each feature
+    /// point moves in the step of length `dt`.
+    fn detect_features(&mut self, model: &Model, x: &[Vec3], reach: f64, dt: f64) {
         let triangles = &self.topology.triangles;
         self.triangle_collider.clear();
         self.triangle_collider
@@ -491,8 +492,9 @@ impl Detection {
                             let d = (a * w[0] + b * w[1] + c * w[2] - anchor).norm();
                             clearance.see(d, d <= FELT * h);
                             if d <= FELT * h {
+                                let carry = slot.shape.velocity(&anchor) * dt;
                                 pairs.push(Pair {
-                                    sides: Sides::Feature(anchor),
+                                    sides: Sides::Feature(anchor, carry),
                                     ids: [tri[0], tri[1], tri[2], u32::MAX],
                                     h,
                                     k,

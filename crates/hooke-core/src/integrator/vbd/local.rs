@@ -3,7 +3,7 @@
 
 use super::detect::{Detection, collider_law};
 use super::graph::Graph;
-use super::pairs::stencil;
+use super::pairs::{Sides, stencil};
 use crate::collider::response::Response;
 use crate::integrator::Sym3;
 use crate::model::Model;
@@ -231,7 +231,14 @@ impl Local<'_> {
                 continue;
             }
             let depth = margin - d;
-            match self.model.colliders[plane.collider as usize].response {
+            let slot = &self.model.colliders[plane.collider as usize];
+            // Damping and friction read the motion relative to a moving collider's surface.
+            let moved = if slot.shape.is_moving() {
+                moved - slot.shape.velocity(&plane.point) * dt
+            } else {
+                moved
+            };
+            match slot.response {
                 Response::Penalty { kc, dc } => {
                     if depth <= 0.0 {
                         continue;
@@ -286,6 +293,9 @@ impl Local<'_> {
                     None => continue,
                 }
             };
+            if let Sides::Feature(_, carry) = pair.sides {
+                slip -= carry;
+            }
             let law = normal_law(d, pair.h, pair.k, n);
             b.contact(law, Some(d), pair.mu, slip, mine, self.dt);
         }

@@ -25,6 +25,7 @@ mod graph;
 mod local;
 mod pairs;
 mod planes;
+pub(crate) mod swept;
 
 use super::{StepReport, Workspace};
 use crate::integrator::Sym3;

@@ -14,8 +14,9 @@ pub(super) enum Sides {
     /// Edge `ids[0..2]` against edge `ids[2..4]`.
     EdgeEdge,
     /// Triangle `ids[0..3]` against the point of a collider's sharp feature nearest it at
-    /// the detection (the feature's tangent, as [`Plane`] is the faces').
-    Feature(Vec3),
+    /// the detection (the feature's tangent, as [`Plane`] is the faces'), and how far that
+    /// point moves over the step (zero unless the collider moves).
+    Feature(Vec3, Vec3),
 }
 
 /// A contact between two primitives, felt by the particles in `ids`.
@@ -64,7 +65,7 @@ pub(super) fn stencil(pair: &Pair, x: &[Vec3]) -> ([f64; 4], Vec3, usize, bool) 
             let inside = s > 0.0 && s < 1.0 && t > 0.0 && t < 1.0;
             ([1.0 - s, s, t - 1.0, -t], Vec3::zeros(), 4, inside)
         }
-        Sides::Feature(anchor) => {
+        Sides::Feature(anchor, _) => {
             let w = point_triangle(&anchor, p(0), p(1), p(2));
             ([w[0], w[1], w[2], 0.0], anchor, 3, true)
         }
