@@ -496,3 +496,182 @@ fn architecture_names_only_files_that_exist() {
         "ARCHITECTURE.md names files that do not exist: {missing:?}"
     );
 }
+
+/// GitHub's anchor for a heading: lower case, spaces to hyphens, other punctuation dropped.
+fn anchor_of(heading: &str) -> String {
+    heading
+        .trim()
+        .chars()
+        .filter_map(|c| match c {
+            ' ' => Some('-'),
+            c if c.is_alphanumeric() || c == '-' || c == '_' => Some(c.to_ascii_lowercase()),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The relative link targets of a Markdown page outside its fenced code: `[text](target)`
+/// and HTML `src="target"` / `href="target"`; web addresses are left out.
+fn relative_links(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut fenced = false;
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        if fenced {
+            continue;
+        }
+        let mut rest = line;
+        while let Some(at) = rest.find("](") {
+            let after = &rest[at + 2..];
+            let end = after.find(')').unwrap_or(after.len());
+            out.push(after[..end].trim().to_string());
+            rest = &after[end..];
+        }
+        for attr in ["src=\"", "href=\""] {
+            let mut rest = line;
+            while let Some(at) = rest.find(attr) {
+                let after = &rest[at + attr.len()..];
+                let end = after.find('"').unwrap_or(after.len());
+                out.push(after[..end].to_string());
+                rest = &after[end..];
+            }
+        }
+    }
+    out.retain(|t| !t.contains("://") && !t.starts_with("mailto:") && !t.is_empty());
+    out
+}
+
+/// Whether page `file` has a heading whose anchor is `anchor`.
+fn has_anchor(file: &Path, anchor: &str) -> bool {
+    let text = std::fs::read_to_string(file).unwrap_or_default();
+    let mut fenced = false;
+    text.lines().any(|line| {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+        }
+        !fenced && line.starts_with('#') && anchor_of(line.trim_start_matches('#')) == anchor
+    })
+}
+
+/// Every relative link in README.md, ARCHITECTURE.md, benches/README.md and docs/*.md names
+/// a file or folder that exists, and a `#anchor` into a Markdown page names one of its
+/// headings: a page moved or a section renamed leaves no dead link.
+#[test]
+fn every_relative_link_in_the_docs_resolves() {
+    let root = workspace();
+    let mut pages = vec![
+        root.join("README.md"),
+        root.join("ARCHITECTURE.md"),
+        root.join("benches/README.md"),
+    ];
+    for entry in std::fs::read_dir(root.join("docs")).unwrap() {
+        let p = entry.unwrap().path();
+        if p.extension().is_some_and(|e| e == "md") {
+            pages.push(p);
+        }
+    }
+    let (mut checked, mut dead) = (0, Vec::new());
+    for page in &pages {
+        let text = std::fs::read_to_string(page).unwrap();
+        let here = page.parent().unwrap();
+        for link in relative_links(&text) {
+            checked += 1;
+            let (file, anchor) = link.split_once('#').unwrap_or((&link, ""));
+            let target = if file.is_empty() {
+                page.clone()
+            } else {
+                here.join(file)
+            };
+            let ok = target.exists()
+                && (anchor.is_empty()
+                    || target.extension().is_none_or(|e| e != "md")
+                    || has_anchor(&target, anchor));
+            if !ok {
+                dead.push(format!(
+                    "{}: {link}",
+                    page.strip_prefix(&root).unwrap().display()
+                ));
+            }
+        }
+    }
+    assert!(
+        checked > 40,
+        "only {checked} links found: has the pages' form changed?"
+    );
+    assert!(dead.is_empty(), "dead links: {dead:#?}");
+}
+
+/// The link reader finds links, skips code and web addresses, and makes GitHub's anchors.
+#[test]
+fn the_link_reader_finds_links_and_anchors() {
+    let text =
+        "see [a](<p>.md#x) and <img src=\"<g>.png\">\n```\n[no](<b>.md)\n```\n[web](https://x.org)";
+    assert_eq!(relative_links(text), vec!["<p>.md#x", "<g>.png"]);
+    assert_eq!(
+        anchor_of(" 4.1 Block descent (`vbd`): large steps without crossings"),
+        "41-block-descent-vbd-large-steps-without-crossings"
+    );
+}
+
+/// What cargo writes into every package itself, not taken from the crate's folder.
+const GENERATED: [&str; 4] = [
+    ".cargo_vcs_info.json",
+    "Cargo.lock",
+    "Cargo.toml",
+    "Cargo.toml.orig",
+];
+
+/// `cargo package --workspace --no-verify` succeeds (every path dependency has a version),
+/// and each publishable crate's package holds only files of its own folder, with the
+/// metadata crates.io shows.
+#[test]
+fn every_publishable_crate_packages_from_its_own_folder() {
+    let root = workspace();
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let target = std::env::temp_dir().join(format!("hooke-package-{}", std::process::id()));
+    let cargo_run = |args: &[&str]| {
+        let out = std::process::Command::new(&cargo)
+            .args(args)
+            .args(["--allow-dirty", "--offline", "--target-dir"])
+            .arg(&target)
+            .current_dir(&root)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "cargo {}: {}",
+            args.join(" "),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    cargo_run(&["package", "--workspace", "--no-verify"]);
+    let mut published = 0;
+    for entry in std::fs::read_dir(root.join("crates")).unwrap() {
+        let dir = entry.unwrap().path();
+        let manifest = std::fs::read_to_string(dir.join("Cargo.toml")).unwrap();
+        if manifest.contains("publish = false") {
+            continue;
+        }
+        published += 1;
+        let name = dir.file_name().unwrap().to_str().unwrap();
+        for key in ["description", "license", "keywords", "categories", "readme"] {
+            assert!(
+                manifest.lines().any(|l| l.starts_with(key)),
+                "{name}: no `{key}` in its Cargo.toml"
+            );
+        }
+        let list = cargo_run(&["package", "--list", "-p", name]);
+        for file in list.lines().filter(|f| !GENERATED.contains(f)) {
+            assert!(
+                dir.join(file).is_file(),
+                "{name} packages {file}, which is not a file of crates/{name}/"
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&target);
+    assert!(published >= 6, "only {published} publishable crates found");
+}

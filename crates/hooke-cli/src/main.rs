@@ -205,7 +205,13 @@ struct RenderArgs {
 fn quiet_on_closed_pipe() {
     let default = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
-        let message = info.payload_as_str().unwrap_or_default();
+        // `PanicHookInfo::payload_as_str` would do, from Rust 1.91; the crate builds on 1.89.
+        let payload = info.payload();
+        let message = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or_default();
         if message.starts_with("failed printing to stdout") && message.contains("os error 32") {
             std::process::exit(141);
         }

@@ -238,3 +238,26 @@ fn an_interrupted_first_report_runs_again_into_its_folder() {
     assert_eq!(third.status.code(), Some(0), "{}", stderr(&third));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A report that cannot find the references it compares with (golden images, the worlds'
+/// locked trajectories, the course worlds: files of a clone, not of the installed program)
+/// stops before any check with status 2, says what it looked for and where, and writes
+/// nothing.
+#[test]
+fn a_report_without_its_references_says_where_it_looked_and_writes_nothing() {
+    let dir = scratch("report-references");
+    let empty = dir.join("not-a-clone");
+    std::fs::create_dir_all(&empty).unwrap();
+    let out = hooke_in(&dir)
+        .args(["report", "rep", "--quick"])
+        .env("HOOKE_REPOSITORY", &empty)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let says = stderr(&out);
+    for part in ["golden/", "not-a-clone", "HOOKE_REPOSITORY"] {
+        assert!(says.contains(part), "no {part:?} in: {says}");
+    }
+    assert!(!dir.join("rep").exists(), "a report folder was made");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -3,7 +3,7 @@
 
 use crate::error::{BuildError, invalid};
 use crate::scene::ColliderGeometry;
-use crate::spec::{ColliderShapeSpec, ResponseSpec, vec3};
+use crate::spec::{ColliderShapeSpec, ResponseSpec, SceneSpec, vec3};
 use hooke_collide::{BoxInterior, Cylinder, MeshError, Placement, Plane, TriMeshCollider};
 use hooke_core::{Collider, Response, Vec3};
 use std::path::{Path, PathBuf};
@@ -171,5 +171,23 @@ pub(crate) fn response(spec: &ResponseSpec) -> Response {
             friction: friction.get(),
         },
         ResponseSpec::Stick => Response::Stick,
+    }
+}
+
+impl SceneSpec {
+    /// The files building the scene reads, each with the key that names it
+    /// (`collider[2].shape.path`): its mesh files, resolved against `base` (built-in meshes
+    /// are no files). For checking, before a run, that no output replaces one.
+    pub fn input_files(&self, base: &Path) -> Vec<(String, PathBuf)> {
+        self.colliders
+            .iter()
+            .enumerate()
+            .filter_map(|(c, collider)| match &collider.shape {
+                ColliderShapeSpec::Mesh { path, .. } if !path.starts_with("builtin:") => {
+                    Some((format!("collider[{c}].shape.path"), base.join(path)))
+                }
+                _ => None,
+            })
+            .collect()
     }
 }

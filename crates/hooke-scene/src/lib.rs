@@ -19,10 +19,13 @@
 
 #![forbid(unsafe_code)]
 
+mod air;
+mod body;
 mod build;
 pub mod builtin;
 pub mod collider_mesh;
 mod colliders;
+mod contact_surface;
 mod edit;
 mod error;
 pub mod footprint;

@@ -115,7 +115,7 @@ pub fn load_scene(path: &Path) -> Result<SceneSpec, SceneError> {
 pub fn to_toml(spec: &SceneSpec) -> String {
     let body = wrap_long_arrays(&toml::to_string(spec).expect("scene specs always serialise"));
     format!(
-        "# Hooke scene '{}': {}\n# Format: see crates/hooke-scene/src/spec.rs and the README.\n\n{body}",
+        "# Hooke scene '{}': {}\n# Format: see docs/scenes.md (the reference is crates/hooke-scene/src/spec.rs).\n\n{body}",
         spec.name, spec.description
     )
 }

@@ -18,6 +18,7 @@ pub mod pixels;
 
 pub use physics::{RHO, falling_sheet};
 mod plots;
+mod references;
 mod scenes;
 mod worlds;
 
@@ -70,6 +71,8 @@ const ENERGY_TOLERANCE: f64 = 0.01;
 pub fn write(dir: &Path, options: &Options) -> Result<Outcome> {
     let quick = options.quick;
     let checked = scenes::names(quick);
+    // Before anything is written: a report that cannot compare cannot run.
+    let references = references::References::find(&checked)?;
     crate::output::check_output_folder(dir, "report")?;
     folder::check(dir, &checked)?;
     std::fs::create_dir_all(dir).map_err(|e| {
@@ -102,9 +105,9 @@ pub fn write(dir: &Path, options: &Options) -> Result<Outcome> {
     lap("closed forms");
     let energy = energy::runs(quick, &mut tick)?;
     lap("energy");
-    let scenes = scenes::checks(quick, &mut files, &mut tick)?;
+    let scenes = scenes::checks(quick, &references, &mut files, &mut tick)?;
     lap("scenes");
-    let worlds = worlds::runs(quick, &mut tick)?;
+    let worlds = worlds::runs(quick, &references, &mut tick)?;
     lap("worlds");
     let determinism = machine::determinism(quick, &mut tick)?;
     lap("determinism");

@@ -5,6 +5,7 @@
 use super::crossings::{self, Tri};
 use super::folder::Pending;
 use super::pixels::compare;
+use super::references::References;
 use crate::Result;
 use crate::image_out::View;
 use crate::stills::{still_steps, still_view};
@@ -13,40 +14,6 @@ use hooke_core::contact::proximity::point_triangle;
 use hooke_scene::{Overrides, Scene};
 use serde::Serialize;
 use std::path::Path;
-
-/// The golden stills of `golden/`, built into the binary so the report needs no checkout.
-const GOLDEN: [(&str, &[u8]); 9] = [
-    (
-        "single-spring",
-        include_bytes!("../../../../golden/single-spring.png"),
-    ),
-    ("chain", include_bytes!("../../../../golden/chain.png")),
-    (
-        "jello-cube",
-        include_bytes!("../../../../golden/jello-cube.png"),
-    ),
-    (
-        "hanging-cloth",
-        include_bytes!("../../../../golden/hanging-cloth.png"),
-    ),
-    (
-        "cloth-table",
-        include_bytes!("../../../../golden/cloth-table.png"),
-    ),
-    (
-        "cloth-pile",
-        include_bytes!("../../../../golden/cloth-pile.png"),
-    ),
-    ("flag", include_bytes!("../../../../golden/flag.png")),
-    (
-        "tablecloth",
-        include_bytes!("../../../../golden/tablecloth.png"),
-    ),
-    (
-        "puck-sweep",
-        include_bytes!("../../../../golden/puck-sweep.png"),
-    ),
-];
 
 /// Scenes quick enough for `--quick`.
 const QUICK: [&str; 3] = ["single-spring", "chain", "jello-cube"];
@@ -208,9 +175,9 @@ fn check(name: &str, golden: &[u8], files: &mut Pending) -> Result<SceneCheck> {
     })
 }
 
-/// The scenes checked: all nine, or the quick ones.
+/// The scenes checked: every built-in, or the quick ones.
 pub(crate) fn names(quick: bool) -> Vec<&'static str> {
-    GOLDEN
+    hooke_scene::builtin::BUILTINS
         .iter()
         .map(|(n, _)| *n)
         .filter(|n| !quick || QUICK.contains(n))
@@ -220,13 +187,14 @@ pub(crate) fn names(quick: bool) -> Vec<&'static str> {
 /// Every scene of [`names`], `tick` after each.
 pub(crate) fn checks(
     quick: bool,
+    references: &References,
     files: &mut Pending,
     tick: &mut dyn FnMut(),
 ) -> Result<Vec<SceneCheck>> {
     let mut out = Vec::new();
     for name in names(quick) {
-        let golden = GOLDEN.iter().find(|(n, _)| *n == name).unwrap().1;
-        out.push(check(name, golden, files)?);
+        let golden = references.golden(name)?;
+        out.push(check(name, &golden, files)?);
         tick();
     }
     Ok(out)

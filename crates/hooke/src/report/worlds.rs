@@ -4,50 +4,11 @@
 //! it must be within the references' rounding; the others show how far each scheme drifts
 //! from it at the world's step.
 
+use super::references::{References, WORLDS};
 use crate::Result;
 use hooke_core::Integrator;
 use hooke_scene::Overrides;
 use serde::Serialize;
-
-/// The worlds and their references, built in.
-const WORLDS: [(&str, &str); 5] = [
-    (
-        "jello",
-        include_str!("../../../../tests/snapshots/validation__worlds__world_jello.snap"),
-    ),
-    (
-        "gravity",
-        include_str!("../../../../tests/snapshots/validation__worlds__world_gravity.snap"),
-    ),
-    (
-        "moveLeft",
-        include_str!("../../../../tests/snapshots/validation__worlds__world_moveLeft.snap"),
-    ),
-    (
-        "rotate",
-        include_str!("../../../../tests/snapshots/validation__worlds__world_rotate.snap"),
-    ),
-    (
-        "skewedCorner",
-        include_str!("../../../../tests/snapshots/validation__worlds__world_skewedCorner.snap"),
-    ),
-];
-const WORLD_FILES: [(&str, &str); 5] = [
-    ("jello", include_str!("../../../../assets/worlds/jello.w")),
-    (
-        "gravity",
-        include_str!("../../../../assets/worlds/gravity.w"),
-    ),
-    (
-        "moveLeft",
-        include_str!("../../../../assets/worlds/moveLeft.w"),
-    ),
-    ("rotate", include_str!("../../../../assets/worlds/rotate.w")),
-    (
-        "skewedCorner",
-        include_str!("../../../../assets/worlds/skewedCorner.w"),
-    ),
-];
 
 /// The references' rounding: six significant digits of coordinates below 10 m.
 pub(crate) const ROUNDING: f64 = 5e-5;
@@ -140,16 +101,21 @@ fn run(
 }
 
 /// Every world with every integrator (the world's own only, with `quick`).
-pub(crate) fn runs(quick: bool, tick: &mut dyn FnMut()) -> Result<Vec<WorldRun>> {
+pub(crate) fn runs(
+    quick: bool,
+    references: &References,
+    tick: &mut dyn FnMut(),
+) -> Result<Vec<WorldRun>> {
     let mut out = Vec::new();
-    for ((name, snapshot), (_, text)) in WORLDS.iter().zip(WORLD_FILES) {
-        let reference = reference(snapshot);
-        let own = hooke_scene::world::parse_world(text, std::path::Path::new(name))?.integrator;
+    for name in WORLDS {
+        let reference = reference(&references.snapshot(name)?);
+        let text = references.world(name)?;
+        let own = hooke_scene::world::parse_world(&text, std::path::Path::new(name))?.integrator;
         for i in Integrator::ALL {
             if quick && i != own {
                 continue;
             }
-            out.push(run(name, text, &reference, i, i == own)?);
+            out.push(run(name, &text, &reference, i, i == own)?);
         }
         tick();
     }

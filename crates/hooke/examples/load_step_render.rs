@@ -1,5 +1,5 @@
 //! Load a scene with overrides, step it, read its state and render a still: what the
-//! README's first Python example does with `hooke.load`, `advance`, `positions`, `render`.
+//! first Python example of docs/python.md does with `hooke.load`, `advance`, `positions`, `render`.
 //!
 //!     cargo run --release --example load_step_render -- [SCENE] [OUT.png]
 

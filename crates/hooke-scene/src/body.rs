@@ -1,0 +1,224 @@
+//! One body's particles, masses and springs: from its springs (`[body.springs]`, a mass per
+//! particle) or from a material (`[body.material]`), and its keyframed pins.
+
+use crate::error::{BuildError, invalid};
+use crate::generators::Lattice;
+use crate::limits::MAX_PARTICLES;
+use crate::scene::Topology;
+use crate::spec::*;
+use hooke_core::{Particles, PinMotion, Spring, SpringKind, Vec3};
+
+/// A body's particles in its own frame, their masses, springs and shape.
+pub(crate) struct BuiltBody {
+    pub(crate) local: Vec<Vec3>,
+    /// Per particle, kg.
+    pub(crate) masses: Vec<f64>,
+    pub(crate) springs: Vec<Spring>,
+    pub(crate) topology: Topology,
+}
+
+/// Builds body `key` (its particles numbered from `offset`).
+pub(crate) fn build_body(
+    body: &BodySpec,
+    key: &str,
+    offset: usize,
+) -> Result<BuiltBody, BuildError> {
+    if let Some(material) = &body.material {
+        return material_body(body, material, key, offset);
+    }
+    let Some(mass) = body.mass else {
+        return Err(invalid(
+            format!("{key}.mass"),
+            "missing: give `mass` (kg per particle) and `springs`, or a `[body.material]`",
+        ));
+    };
+    let mut built = spring_body(body, key, offset)?;
+    built.masses = vec![mass.get(); built.local.len()];
+    Ok(built)
+}
+
+/// A body's keyframed pins (docs/physics.md §1.2): its pinned particles, moved by `motion`.
+pub(crate) fn pin_motion(
+    body: &BodySpec,
+    motion: &crate::spec::MotionSpec,
+    key: &str,
+    start: usize,
+    particles: &Particles,
+) -> Result<PinMotion, BuildError> {
+    if body.pins.is_empty() {
+        return Err(invalid(
+            format!("{key}.pin_motion"),
+            "it moves the body's pinned particles, and the body has none: give `pins`",
+        ));
+    }
+    let keys = crate::colliders::keyframes(motion, &format!("{key}.pin_motion"))?;
+    let mut ids: Vec<u32> = body.pins.iter().map(|&p| (start + p) as u32).collect();
+    ids.sort_unstable();
+    ids.dedup();
+    Ok(PinMotion::new(ids, &particles.x, keys))
+}
+
+/// A grid given as a material: its masses and springs derived for its spacing.
+fn material_body(
+    body: &BodySpec,
+    material: &crate::spec::MaterialSpec,
+    key: &str,
+    offset: usize,
+) -> Result<BuiltBody, BuildError> {
+    let given: Vec<&str> = [
+        ("mass", body.mass.is_some()),
+        ("springs", !body.springs.is_empty()),
+    ]
+    .iter()
+    .filter(|(_, on)| *on)
+    .map(|(name, _)| *name)
+    .collect();
+    if !given.is_empty() {
+        return Err(invalid(
+            format!("{key}.material"),
+            format!(
+                "a material gives the masses and springs: remove {} (or the material)",
+                given
+                    .iter()
+                    .map(|k| format!("`{k}`"))
+                    .collect::<Vec<_>>()
+                    .join(" and ")
+            ),
+        ));
+    }
+    let ShapeSpec::Grid { size, spacing } = &body.shape else {
+        return Err(invalid(
+            format!("{key}.material"),
+            "a material is for a cloth: the body's shape must be a `grid`",
+        ));
+    };
+    let material = material.resolve(&format!("{key}.material"))?;
+    let mut built = spring_body(body, key, offset)?;
+    built.masses = material.masses(*size, spacing.get());
+    let n = built.local.len();
+    let mut held = vec![false; n];
+    for &p in body.pins.iter().filter(|&&p| p < n) {
+        held[p] = true;
+    }
+    let pinned = |p: usize| held[p];
+    built.springs = material.springs(*size, spacing.get(), offset, &pinned);
+    Ok(built)
+}
+
+/// A body's particles and the springs its `springs` table gives (masses left empty).
+fn spring_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, BuildError> {
+    let (lattice, h, topology) = match &body.shape {
+        ShapeSpec::Chain { count, spacing } => (
+            Lattice {
+                size: [*count, 1, 1],
+            },
+            spacing.get(),
+            Topology::Chain,
+        ),
+        ShapeSpec::Grid { size, spacing } => (
+            Lattice {
+                size: [size[0], 1, size[1]],
+            },
+            spacing.get(),
+            Topology::Grid(*size),
+        ),
+        ShapeSpec::Lattice { size, spacing } => (
+            Lattice { size: *size },
+            spacing.get(),
+            Topology::Lattice(*size),
+        ),
+        ShapeSpec::Points { positions } => {
+            let local: Vec<Vec3> = positions.iter().map(vec3).collect();
+            if body.springs.structural.is_some()
+                || body.springs.shear.is_some()
+                || body.springs.bend.is_some()
+            {
+                return Err(invalid(
+                    format!("{key}.springs"),
+                    "points have no topology: use explicit `pairs`, not structural/shear/bend",
+                ));
+            }
+            let springs = pairs(body, key, &local, offset)?;
+            return Ok(BuiltBody {
+                local,
+                masses: Vec::new(),
+                springs,
+                topology: Topology::Points,
+            });
+        }
+    };
+    let count = lattice
+        .size
+        .iter()
+        .try_fold(1usize, |acc, &n| acc.checked_mul(n));
+    if !count.is_some_and(|n| (1..=MAX_PARTICLES).contains(&n)) {
+        let total = count.map_or("more than 2^64".to_string(), |n| n.to_string());
+        let (field, found) = match &body.shape {
+            ShapeSpec::Chain { count, .. } => ("count", format!("{count}")),
+            ShapeSpec::Grid { size, .. } => ("size", format!("{size:?} ({total} particles)")),
+            ShapeSpec::Lattice { size, .. } => ("size", format!("{size:?} ({total} particles)")),
+            ShapeSpec::Points { positions } => ("positions", format!("{} points", positions.len())),
+        };
+        return Err(invalid(
+            format!("{key}.shape.{field}"),
+            format!("expected 1 to {MAX_PARTICLES} particles, found {found}"),
+        ));
+    }
+    let local = lattice.positions(h);
+    let mut springs = Vec::new();
+    for kind in [SpringKind::Structural, SpringKind::Shear, SpringKind::Bend] {
+        if let Some(p) = body.springs.params(kind) {
+            springs.extend(lattice.edges(kind, h).into_iter().map(|e| Spring {
+                i: (offset + e.i as usize) as u32,
+                j: (offset + e.j as usize) as u32,
+                rest: e.rest,
+                ks: p.ks.get(),
+                kd: p.kd.get(),
+                kind,
+            }));
+        }
+    }
+    springs.extend(pairs(body, key, &local, offset)?);
+    Ok(BuiltBody {
+        local,
+        masses: Vec::new(),
+        springs,
+        topology,
+    })
+}
+
+fn pairs(
+    body: &BodySpec,
+    key: &str,
+    local: &[Vec3],
+    offset: usize,
+) -> Result<Vec<Spring>, BuildError> {
+    let n = local.len();
+    body.springs
+        .pairs
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            if p.i >= n || p.j >= n || p.i == p.j {
+                return Err(invalid(
+                    format!("{key}.springs.pairs[{k}]"),
+                    format!(
+                        "expected two different particles below {n}, found i = {}, j = {}",
+                        p.i, p.j
+                    ),
+                ));
+            }
+            let rest = p
+                .rest
+                .map_or_else(|| (local[p.i] - local[p.j]).norm(), |r| r.get());
+            Ok(Spring {
+                i: (offset + p.i) as u32,
+                j: (offset + p.j) as u32,
+                rest,
+                ks: p.ks.get(),
+                kd: p.kd.get(),
+                kind: SpringKind::Other,
+            })
+        })
+        .collect()
+}
