@@ -9,9 +9,10 @@
 //! | inclined plane | [`Plane::inclined`] | on the side opposite the body's start |
 //! | box interior (jello) | [`BoxInterior`] | a coordinate strictly beyond a face |
 //! | analytic cylinder tabletop | [`Cylinder`] | within the disc |
+//! | ball | [`Sphere`] | nearer the centre than the radius |
 //! | triangle mesh (OBJ) | [`TriMeshCollider`] | inside a closed part, or crossed in a step |
 //!
-//! Planes, the box and the cylinder are closed-form (the contract's formulas as written);
+//! Planes, the box, the cylinder and the ball are closed-form (the contract's formulas as written);
 //! meshes use parry3d-f64's BVH, point projection with pseudo-normals and ray casts, and are
 //! read with tobj. This is the only crate that names parry3d or tobj, and it never touches
 //! velocities: responses belong to the core.
@@ -31,6 +32,7 @@ mod box_interior;
 mod cylinder;
 mod obj;
 mod plane;
+mod sphere;
 pub mod table;
 mod trimesh;
 
@@ -38,6 +40,7 @@ pub use box_interior::{BOX_FACES, BoxInterior};
 pub use cylinder::Cylinder;
 pub use obj::{MeshError, MeshPart, Placement, load_obj, parse_obj};
 pub use plane::Plane;
+pub use sphere::Sphere;
 pub use trimesh::{TriMeshCollider, closedness_defect, signed_volume};
 
 use std::path::Path;

@@ -167,9 +167,9 @@ pub fn square_table_obj() -> String {
 pub const BALL_SUBDIVISIONS: usize = 3;
 
 /// A ball of radius 1 about the origin: an icosahedron subdivided
-/// [`BALL_SUBDIVISIONS`] times, its vertices on the sphere, faces counter-clockwise from
-/// outside. Scale it to a radius with a mesh collider's `scale`.
-pub fn ball_obj() -> String {
+/// [`BALL_SUBDIVISIONS`] times, its vertices on the sphere (so its faces are inside it),
+/// faces counter-clockwise from outside, as vertices and 0-based triangles.
+pub fn ball() -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
     let t = (1.0 + 5.0_f64.sqrt()) / 2.0;
     let mut points: Vec<[f64; 3]> = [
         [-1.0, t, 0.0],
@@ -230,6 +230,13 @@ pub fn ball_obj() -> String {
             })
             .collect();
     }
+    (points, faces)
+}
+
+/// [`ball`] as OBJ text: `builtin:ball.obj`. Scale it to a radius with a mesh collider's
+/// `scale`.
+pub fn ball_obj() -> String {
+    let (points, faces) = ball();
     let mut w = ObjWriter::new("ball: radius 1 m about the origin, a subdivided icosahedron");
     w.object("ball");
     for [x, y, z] in &points {

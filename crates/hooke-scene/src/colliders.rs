@@ -4,7 +4,7 @@
 use crate::error::{BuildError, invalid};
 use crate::scene::ColliderGeometry;
 use crate::spec::{ColliderShapeSpec, ResponseSpec, SceneSpec, vec3};
-use hooke_collide::{BoxInterior, Cylinder, MeshError, Placement, Plane, TriMeshCollider};
+use hooke_collide::{BoxInterior, Cylinder, MeshError, Placement, Plane, Sphere, TriMeshCollider};
 use hooke_core::{Collider, Response, Vec3};
 use std::path::{Path, PathBuf};
 
@@ -132,6 +132,13 @@ pub(crate) fn build_collider(
                 thickness: thickness.get(),
             };
             (Box::new(c), ColliderGeometry::Cylinder(c))
+        }
+        ColliderShapeSpec::Sphere { center, radius } => {
+            let s = Sphere {
+                center: vec3(center),
+                radius: radius.get(),
+            };
+            (Box::new(s), ColliderGeometry::Sphere(s))
         }
         ColliderShapeSpec::Mesh {
             path,

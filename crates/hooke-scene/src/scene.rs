@@ -2,7 +2,7 @@
 //! geometry of its colliders for drawing.
 
 use crate::spec::SceneSpec;
-use hooke_collide::{BoxInterior, Cylinder};
+use hooke_collide::{BoxInterior, Cylinder, Sphere};
 use hooke_core::{Simulation, Vec3};
 use std::ops::Range;
 
@@ -45,6 +45,8 @@ pub enum ColliderGeometry {
     Box(BoxInterior),
     /// An analytic cylinder tabletop.
     Cylinder(Cylinder),
+    /// A solid ball.
+    Sphere(Sphere),
     /// A triangle mesh, as world-space triangles.
     Mesh(Vec<[Vec3; 3]>),
 }

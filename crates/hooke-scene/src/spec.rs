@@ -396,13 +396,13 @@ pub struct KeySpec {
 
 impl ColliderShapeSpec {
     /// The point a collider turns about when it moves: a mesh's placed origin
-    /// (`translate`), a box's or a cylinder's centre; `None` for a ground or a plane, which
-    /// cannot move.
+    /// (`translate`), the centre of a box, a cylinder or a sphere; `None` for a ground or a
+    /// plane, which cannot move.
     pub fn pivot(&self) -> Option<Vec3> {
         match self {
             Self::Mesh { translate, .. } => Some(vec3(translate)),
             Self::Box { min, max } => Some((vec3(min) + vec3(max)) / 2.0),
-            Self::Cylinder { center, .. } => Some(vec3(center)),
+            Self::Cylinder { center, .. } | Self::Sphere { center, .. } => Some(vec3(center)),
             Self::Ground { .. } | Self::Plane { .. } => None,
         }
     }
@@ -475,7 +475,7 @@ pub struct ColliderSpec {
     pub shape: ColliderShapeSpec,
     /// What it does to particles that violate it.
     pub response: ResponseSpec,
-    /// Keys that move a mesh, box or cylinder rigidly about its placed origin or centre
+    /// Keys that move a mesh, box, cylinder or sphere rigidly about its placed origin or centre
     /// (docs/physics.md §2.1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub motion: Option<MotionSpec>,
@@ -515,6 +515,13 @@ pub enum ColliderShapeSpec {
         radius: Positive,
         /// Thickness, metres.
         thickness: Positive,
+    },
+    /// A solid ball.
+    Sphere {
+        /// Centre, metres.
+        center: [Finite; 3],
+        /// Radius, metres.
+        radius: Positive,
     },
     /// A triangle mesh from an OBJ file. `path` is relative to the scene file; `builtin:NAME`
     /// names a mesh shipped inside Hooke (`builtin:table.obj`, `builtin:square-table.obj`, and `builtin:ball.obj`, a ball of radius 1 m to scale).

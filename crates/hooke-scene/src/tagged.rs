@@ -128,6 +128,7 @@ enum ColliderKind {
     Plane,
     Box,
     Cylinder,
+    Sphere,
     Mesh,
 }
 
@@ -174,6 +175,13 @@ impl TryFrom<ColliderShapeTable> for ColliderShapeSpec {
                     center: need("cylinder", "center", t.center)?,
                     radius: need("cylinder", "radius", t.radius)?,
                     thickness: need("cylinder", "thickness", t.thickness)?,
+                }
+            }
+            ColliderKind::Sphere => {
+                only("sphere", &["center", "radius"], &present)?;
+                ColliderShapeSpec::Sphere {
+                    center: need("sphere", "center", t.center)?,
+                    radius: need("sphere", "radius", t.radius)?,
                 }
             }
             ColliderKind::Mesh => {

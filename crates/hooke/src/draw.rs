@@ -285,6 +285,9 @@ pub fn draw_with(scene: &Scene, style: Style, show: impl Fn(SpringKind) -> bool)
             // Drawn where they are: contacts keep cloth a thickness away from them.
             ColliderGeometry::Mesh(tris) => tris.iter().for_each(|t| list.flat(*t, TABLE)),
             ColliderGeometry::Cylinder(cyl) => cylinder(&mut list, cyl),
+            ColliderGeometry::Sphere(ball) => collider_mesh::sphere_triangles(ball)
+                .into_iter()
+                .for_each(|t| list.flat(t, TABLE)),
             ColliderGeometry::Box(b) => {
                 box_edges(&mut list, b.min, b.max);
                 box_bounds = Some((b.min, b.max));
@@ -329,6 +332,10 @@ pub fn frame_camera(scene: &Scene, yaw: f64, pitch: f64) -> Camera {
                 c.center - Vec3::new(c.radius, c.thickness, c.radius),
             ],
             ColliderGeometry::Box(b) => vec![b.min, b.max],
+            ColliderGeometry::Sphere(ball) => vec![
+                ball.center.add_scalar(-ball.radius),
+                ball.center.add_scalar(ball.radius),
+            ],
             _ => vec![],
         };
         let poses = scene.collider_key_poses(k);
