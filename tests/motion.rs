@@ -204,11 +204,15 @@ fn a_moving_platform_drags_a_sheet_at_mu_g_until_it_matches_its_speed() {
 }
 
 /// `cloth-table` on the analytic cylinder table (top at y = 1, radius 0.6 m, stick), the
-/// table keyed to slide 0.3 m along x from 1.5 s to 2.5 s, after the cloth has landed.
-fn sliding_table() -> Scene {
+/// table keyed to slide 0.3 m along x from 1.5 s to 2.5 s, after the cloth has landed; with
+/// the scene's symplectic Euler, or under `run` (integrator and step, a frame per step).
+fn sliding_table(run: Option<(Integrator, f64)>) -> Scene {
     let mut spec = hooke_scene::builtin::builtin("cloth-table").unwrap();
     let overrides = Overrides {
         table: Some("cylinder".parse().unwrap()),
+        integrator: run.map(|r| r.0),
+        dt: run.map(|r| r.1),
+        every: run.map(|_| 1),
         ..Overrides::default()
     };
     overrides.apply(&mut spec).unwrap();
@@ -221,10 +225,16 @@ fn sliding_table() -> Scene {
 /// A table that slides 0.3 m under a cloth stuck to its top carries the cloth with it: the
 /// particles on the top at 1.5 s have moved 0.3 m ± 3 cm along x by 3 s (stick carries a
 /// touching particle at the table's velocity), no exported frame has a crossing, and the
-/// exported table has moved 0.3 m.
+/// exported table has moved 0.3 m; with symplectic Euler at the scene's step and with
+/// block descent at 1/60 s.
 #[test]
 fn a_sliding_table_carries_the_cloth_stuck_to_its_top() {
-    let mut scene = sliding_table();
+    sliding_table_carries(None, "sliding-table");
+    sliding_table_carries(Some((Integrator::Vbd, 1.0 / 60.0)), "sliding-table-vbd");
+}
+
+fn sliding_table_carries(run: Option<(Integrator, f64)>, tag: &str) {
+    let mut scene = sliding_table(run);
     let dt = scene.simulation.dt();
     scene.simulation.advance((1.5 / dt).round() as u64).unwrap();
     let x = scene.simulation.particles().x.clone();
@@ -239,11 +249,11 @@ fn a_sliding_table_carries_the_cloth_stuck_to_its_top() {
     let moved = mean_x(&scene.simulation.particles().x) - before;
     assert!(
         (moved - 0.3).abs() < 0.03,
-        "the top's cloth moved {moved} m"
+        "{tag}: the top's cloth moved {moved} m"
     );
 
-    let last = crate::contact::assert_scene_never_crosses(sliding_table(), "sliding-table");
-    let still = sliding_table();
+    let last = crate::contact::assert_scene_never_crosses(sliding_table(run), tag);
+    let still = sliding_table(run);
     let centre = |tris: &[[Vec3; 3]]| {
         tris.iter().flatten().map(|p| p.x).sum::<f64>() / (3 * tris.len()) as f64
     };
@@ -253,7 +263,7 @@ fn a_sliding_table_carries_the_cloth_stuck_to_its_top() {
     let table_now = centre(&last.colliders[2..]);
     assert!(
         ((table_now - table_then) - 0.3).abs() < 1e-9,
-        "the exported table moved {} m",
+        "{tag}: the exported table moved {} m",
         table_now - table_then
     );
 }
