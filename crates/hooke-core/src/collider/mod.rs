@@ -126,6 +126,11 @@ pub trait Collider: Debug + Send + Sync {
         false
     }
 
+    /// The keys a moving collider follows (`None` for a still one).
+    fn motion(&self) -> Option<&crate::keyframes::Keyframes> {
+        None
+    }
+
     /// How far at most a material point of the collider that is inside the world box
     /// `lo..hi` at time `t0` moves by `t1` (zero for a still collider). Pure: it does not
     /// take the pose, so a caller can try several spans before [`Collider::advance_to`].

@@ -174,6 +174,10 @@ impl Collider for Moving {
         true
     }
 
+    fn motion(&self) -> Option<&Keyframes> {
+        Some(&self.keys)
+    }
+
     fn sweep(&self, (t0, t1): (f64, f64), lo: &Vec3, hi: &Vec3) -> f64 {
         // A point at `pivot + T₀ + R₀ q` goes to `pivot + T₁ + R₁ q`: it moves at most
         // `|T₁ - T₀| + ‖R₁ R₀ᵀ - I‖ |R₀ q|`, and `‖R - I‖ = 2 sin(θ/2)` for a turn by θ;

@@ -7,10 +7,10 @@
 //!
 //! The total energy `E` is kinetic plus potential (springs, gravity, penalty springs), so
 //! gravity and the springs do no net work on it. What may raise it: the force field, the
-//! air, the attachments and keyframed pins (pins held still do no work; a moving
-//! collider's work is not counted). Their work is summed from their
-//! power `Σ max(0, F·v)` sampled at each check, times the time since the last. A run is
-//! runaway when
+//! air, the attachments, keyframed pins (pins held still do no work) and moving colliders.
+//! The work of all but the colliders is summed from their power `Σ max(0, F·v)` sampled at
+//! each check, times the time since the last; a moving collider's is bounded instead, in
+//! the energy scale below. A run is runaway when
 //!
 //! ```text
 //! E − E(0) > 10 S + 2 W
@@ -18,7 +18,9 @@
 //!
 //! with `W` that work and `S` the start's energy scale: its kinetic, spring and penalty
 //! energy plus the weight of every free particle over the bodies' extent and a metre
-//! (`M |g| (L + 1 m)`), or 1 mJ at least. Schemes that merely drift (symplectic Euler's
+//! (`M |g| (L + 1 m)`), and for each moving collider `M (2 u² + |g| D)`, with `u` its largest
+//! speed between keys and `D` the farthest it moves between two keys (a bounce off it and a
+//! lift by it), or 1 mJ at least. Schemes that merely drift (symplectic Euler's
 //! oscillating energy, explicit Euler's slow gain) stay far inside this bound over any run a
 //! scene is meant for; a blow-up leaves it within a few hundredths of a second. Checked
 //! every 10 ms of simulated time (every step when the step is longer), so the check costs a
@@ -82,7 +84,8 @@ impl EnergyWatch {
         let weight = free_mass * model.gravity.norm() * (extent + 1.0);
         // Kinetic, spring and penalty energy: the total less gravity's potential.
         let own = (start - gravity_potential).abs();
-        let scale = (own + weight).max(1e-3);
+        let carried = collider_allowance(model, (&lo, &hi), free_mass);
+        let scale = (own + weight + carried).max(1e-3);
         Self {
             enabled: true,
             interval,
@@ -171,6 +174,32 @@ impl EnergyWatch {
         }
         power + pins
     }
+}
+
+/// The most the moving colliders can give the bodies (their work is not summed as the
+/// pins' is): for each, every free particle thrown at twice the collider's largest speed
+/// (a bounce off it) and lifted by the farthest it moves between two keys, both measured
+/// with [`crate::Collider::sweep`] over the bodies' box at the start.
+fn collider_allowance(model: &Model, (lo, hi): (&Vec3, &Vec3), free_mass: f64) -> f64 {
+    let mut total = 0.0;
+    for slot in &model.colliders {
+        let Some(keys) = slot.shape.motion() else {
+            continue;
+        };
+        let times: Vec<f64> = keys.keys().iter().map(|k| k.t).collect();
+        let (mut speed, mut reach) = (0.0_f64, 0.0_f64);
+        for (a, &ta) in times.iter().enumerate() {
+            for &tb in &times[a + 1..] {
+                let s = slot.shape.sweep((ta, tb), lo, hi);
+                reach = reach.max(s);
+                if tb > ta {
+                    speed = speed.max(s / (tb - ta));
+                }
+            }
+        }
+        total += free_mass * (2.0 * speed * speed + model.gravity.norm() * reach);
+    }
+    total
 }
 
 /// The power keyframed pins put in now: each moving pinned particle is held against its
