@@ -675,3 +675,34 @@ fn every_publishable_crate_packages_from_its_own_folder() {
     let _ = std::fs::remove_dir_all(&target);
     assert!(published >= 6, "only {published} publishable crates found");
 }
+
+/// The README stays a first read: at most 200 lines, its first 40 holding a picture and the
+/// two commands, and no commit named (a hex word of 7 to 40 digits and letters).
+#[test]
+fn the_readme_is_short_and_its_first_screen_shows_and_tells() {
+    let text = std::fs::read_to_string(workspace().join("README.md")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines.len() <= 200, "README.md has {} lines", lines.len());
+    let first = lines[..40.min(lines.len())].join("\n");
+    for needed in [
+        "cargo run --release -p hooke-cli -- demo",
+        "cargo xtask test",
+        "<img src=",
+    ] {
+        assert!(
+            first.contains(needed),
+            "no {needed:?} in README.md's first 40 lines"
+        );
+    }
+    let commits: Vec<&str> = text
+        .split(|c: char| !c.is_ascii_alphanumeric())
+        .filter(|w| {
+            (7..=40).contains(&w.len())
+                && w.chars()
+                    .all(|c| c.is_ascii_digit() || ('a'..='f').contains(&c))
+                && w.chars().any(|c| c.is_ascii_digit())
+                && w.chars().any(|c| c.is_ascii_alphabetic())
+        })
+        .collect();
+    assert!(commits.is_empty(), "README.md names commits: {commits:?}");
+}
