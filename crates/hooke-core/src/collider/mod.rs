@@ -131,9 +131,11 @@ pub trait Collider: Debug + Send + Sync {
         None
     }
 
-    /// How far at most a material point of the collider that is inside the world box
-    /// `lo..hi` at time `t0` moves by `t1` (zero for a still collider). Pure: it does not
-    /// take the pose, so a caller can try several spans before [`Collider::advance_to`].
+    /// How far at most a material point of the collider moves from time `t0` to `t1`, of
+    /// the points that start, end or pass as near a point of the world box `lo..hi` as
+    /// they move (zero for a still collider; infinite when no bound is known, as for a
+    /// turn of 60° or more). Pure: it does not take the pose, so a caller can try several
+    /// spans before [`Collider::advance_to`].
     fn sweep(&self, (t0, t1): (f64, f64), lo: &Vec3, hi: &Vec3) -> f64 {
         let _ = (t0, t1, lo, hi);
         0.0

@@ -179,16 +179,22 @@ impl Collider for Moving {
     }
 
     fn sweep(&self, (t0, t1): (f64, f64), lo: &Vec3, hi: &Vec3) -> f64 {
-        // A point at `pivot + T₀ + R₀ q` goes to `pivot + T₁ + R₁ q`: it moves at most
-        // `|T₁ - T₀| + ‖R₁ R₀ᵀ - I‖ |R₀ q|`, and `‖R - I‖ = 2 sin(θ/2)` for a turn by θ;
-        // `|R₀ q|` is largest at a corner of the box (a convex function's maximum).
+        // A point at `pivot + T₀ + R₀ q` goes to `pivot + T₁ + R₁ q`: it moves
+        // `d ≤ |T₁ - T₀| + k |R₀ q|`, with `k = ‖R₁ R₀ᵀ - I‖ = 2 sin(θ/2)` for a turn by θ.
+        // A point that ends up, or passes, within `d` of a point of the box started within
+        // `d` of it, so `|R₀ q| ≤ r + d` with `r` the box's farthest corner from
+        // `pivot + T₀` (a convex function's maximum): `d ≤ (|ΔT| + k r) / (1 - k)`, finite
+        // for turns under 60°.
         let (a, b) = (Self::pose(&self.keys, t0), Self::pose(&self.keys, t1));
-        let turn = (b.rotation * a.rotation.inverse()).angle();
+        let k = 2.0 * (0.5 * (b.rotation * a.rotation.inverse()).angle()).sin();
+        if k >= 1.0 {
+            return f64::INFINITY;
+        }
         let reach = corners(lo, hi)
             .iter()
             .map(|c| (c - self.pivot - a.translate).norm())
             .fold(0.0, f64::max);
-        (b.translate - a.translate).norm() + 2.0 * (0.5 * turn).sin() * reach
+        ((b.translate - a.translate).norm() + k * reach) / (1.0 - k)
     }
 
     fn velocity(&self, p: &Vec3) -> Vec3 {
@@ -201,5 +207,63 @@ impl Collider for Moving {
 
     fn carried(&self, p: &Vec3) -> Vec3 {
         self.world(&self.before.shape_of(&self.pivot, p))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::keyframes::Key;
+
+    /// A shape with no surface: only the pose matters here.
+    #[derive(Debug)]
+    struct Nothing;
+
+    impl Collider for Nothing {
+        fn name(&self) -> String {
+            "nothing".into()
+        }
+        fn contacts(&self, _: &Vec3, _: &mut dyn FnMut(Contact)) {}
+    }
+
+    /// Keys turning `degrees` about y while moving 0.3 m along x, from 0 s to 1 s, about
+    /// a pivot at (1, 0, 0).
+    fn turning(degrees: f64) -> Moving {
+        let key = |t: f64, x: f64, ry: f64| Key {
+            t,
+            translate: Vec3::new(x, 0.0, 0.0),
+            rotate: Vec3::new(0.0, ry, 0.0),
+        };
+        let keys = Keyframes::new(vec![key(0.0, 0.0, 0.0), key(1.0, 0.3, degrees)]).unwrap();
+        Moving::new(Box::new(Nothing), Vec3::new(1.0, 0.0, 0.0), keys)
+    }
+
+    /// Every material point that starts or ends in the box moves no farther than the sweep
+    /// says, for turns up to 50°; at 60° and more there is no bound.
+    #[test]
+    fn the_sweep_bounds_every_point_that_meets_the_box() {
+        let (lo, hi) = (Vec3::new(-0.5, -0.2, -0.5), Vec3::new(0.5, 0.2, 0.5));
+        let inside = |p: &Vec3| (0..3).all(|k| lo[k] <= p[k] && p[k] <= hi[k]);
+        for degrees in [0.0, 5.0, 20.0, 50.0] {
+            let m = turning(degrees);
+            let s = m.sweep((0.0, 1.0), &lo, &hi);
+            let (a, b) = (Moving::pose(&m.keys, 0.0), Moving::pose(&m.keys, 1.0));
+            let mut met = 0;
+            for i in 0..41 {
+                for j in 0..41 {
+                    // Shape-frame points over a 4 m square about the pivot.
+                    let q = Vec3::new(-1.0 + 0.1 * i as f64, 0.1, -2.0 + 0.1 * j as f64);
+                    let (from, to) = (a.world_of(&m.pivot, &q), b.world_of(&m.pivot, &q));
+                    if inside(&from) || inside(&to) {
+                        met += 1;
+                        let d = (to - from).norm();
+                        assert!(d <= s * (1.0 + 1e-12), "{degrees}°: {d} > {s}");
+                    }
+                }
+            }
+            assert!(met > 50, "{degrees}°: only {met} points met the box");
+        }
+        assert_eq!(turning(60.0).sweep((0.0, 1.0), &lo, &hi), f64::INFINITY);
+        assert_eq!(turning(0.0).sweep((0.0, 1.0), &lo, &hi), 0.3);
     }
 }

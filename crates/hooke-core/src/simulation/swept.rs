@@ -65,14 +65,21 @@ impl Simulation {
         let mut span = end - t;
         let least = self.dt / f64::from(MOST_PARTS);
         let (lo, hi) = particle_box(&self.particles.x);
+        // Gaps beyond this need not be known: the particles' box and a metre.
+        let far = (hi - lo).norm() + 1.0;
         for (k, slot) in self.model.colliders.iter().enumerate() {
             let full = slot.shape.sweep((t, end), &lo, &hi);
             if full == 0.0 {
                 continue;
             }
-            let room = SHARE * collider_gap(&self.model, &self.particles, k, full / SHARE);
+            let reach = (full / SHARE).min(far);
+            let room = SHARE * collider_gap(&self.model, &self.particles, k, reach);
             // The sweep grows with the span; halve from the proportional guess until it fits.
-            let mut s = (end - t) * (room / full).min(1.0);
+            let mut s = if full.is_finite() {
+                (end - t) * (room / full).min(1.0)
+            } else {
+                end - t
+            };
             while s > least && slot.shape.sweep((t, t + s), &lo, &hi) > room {
                 s *= 0.5;
             }
