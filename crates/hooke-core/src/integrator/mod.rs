@@ -22,7 +22,7 @@ use std::fmt;
 use std::str::FromStr;
 
 pub(crate) use blocks::Sym3;
-pub(crate) use vbd::swept::{collider_gap, particle_box};
+pub(crate) use vbd::swept::collider_gap;
 
 /// The integration scheme; maps 1:1 to the `--integrator` flag and the scene files' names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

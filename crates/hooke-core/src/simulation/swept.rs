@@ -9,7 +9,8 @@
 //! before each part.
 
 use super::Simulation;
-use crate::integrator::{StepReport, collider_gap, particle_box};
+use super::summary;
+use crate::integrator::{StepReport, collider_gap};
 
 /// Parts at most in one step: a particle held between a moving collider and something
 /// still (or a pinned one in its way) closes its gap to nothing, and the parts stop here.
@@ -26,7 +27,7 @@ impl Simulation {
         let (mut iterations, mut detections, mut capped, mut residual) = (0, 0, false, 0.0_f64);
         let mut t = time;
         loop {
-            let span = self.part(t, end).max(least);
+            let span = self.part((t, end), least).max(least);
             let next = if t + span >= end - 1e-9 * least {
                 end
             } else {
@@ -60,11 +61,11 @@ impl Simulation {
     }
 
     /// The longest span from `t` (at most to `end`) over which no moving collider closes
-    /// more than [`SHARE`] of its gap, the colliders being at their pose at `t`.
-    fn part(&self, t: f64, end: f64) -> f64 {
+    /// more than [`SHARE`] of its gap, the colliders being at their pose at `t`; halving
+    /// stops at `least`.
+    fn part(&self, (t, end): (f64, f64), least: f64) -> f64 {
         let mut span = end - t;
-        let least = self.dt / f64::from(MOST_PARTS);
-        let (lo, hi) = particle_box(&self.particles.x);
+        let (lo, hi) = summary::bounds(&self.particles.x);
         // Gaps beyond this need not be known: the particles' box and a metre.
         let far = (hi - lo).norm() + 1.0;
         for (k, slot) in self.model.colliders.iter().enumerate() {

@@ -203,7 +203,8 @@ fn chunked<T: Send>(n: usize, f: impl Fn(Range<usize>) -> Vec<T> + Sync + Send) 
     parts.into_iter().flatten().collect()
 }
 
-fn bounds_of(points: &[&Vec3]) -> (Vec3, Vec3) {
+/// The box holding `points` (at least one).
+pub(super) fn bounds_of(points: &[&Vec3]) -> (Vec3, Vec3) {
     let mut lo = *points[0];
     let mut hi = *points[0];
     for p in &points[1..] {

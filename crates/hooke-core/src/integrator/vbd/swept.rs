@@ -1,9 +1,10 @@
 //! How near the particles and surfaces are to a moving collider, which sets how far block
 //! descent may let the collider jump at once (the swept step, docs/physics.md §4.1).
 
+use super::detect::bounds_of;
 use super::pairs::feature_triangle;
 use crate::model::Model;
-use crate::particles::{Particles, Vec3};
+use crate::particles::Particles;
 
 /// The least distance from a free particle, or from a triangle of a surface, to collider
 /// `k` at its current pose, capped at `reach`. A particle already inside counts as far:
@@ -25,21 +26,12 @@ pub(crate) fn collider_gap(model: &Model, p: &Particles, k: usize, reach: f64) -
     if shape.has_features() {
         for tri in model.surfaces.iter().flat_map(|s| &s.triangles) {
             let [a, b, c] = tri.map(|i| &p.x[i as usize]);
-            let lo = a.inf(b).inf(c).add_scalar(-reach);
-            let hi = a.sup(b).sup(c).add_scalar(reach);
-            shape.features(&lo, &hi, &mut |f| {
+            let (lo, hi) = bounds_of(&[a, b, c]);
+            shape.features(&lo.add_scalar(-reach), &hi.add_scalar(reach), &mut |f| {
                 let (anchor, w) = feature_triangle(&f, a, b, c);
                 gap = gap.min((a * w[0] + b * w[1] + c * w[2] - anchor).norm());
             });
         }
     }
     gap
-}
-
-/// The box holding every particle.
-pub(crate) fn particle_box(x: &[Vec3]) -> (Vec3, Vec3) {
-    x.iter().fold(
-        (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
-    )
 }
