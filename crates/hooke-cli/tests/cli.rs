@@ -292,9 +292,11 @@ fn ctrl_c_stops_a_run_at_a_complete_frame() {
         rows.len()
     );
     assert!(rows.iter().all(|r| r.split(',').count() == 9));
+    // Beside the frames, only hooke's hidden marker.
     let frames: Vec<_> = std::fs::read_dir(dir.join("frames"))
         .unwrap()
         .map(|e| e.unwrap().path())
+        .filter(|p| p.file_name().unwrap() != ".hooke-frames")
         .collect();
     assert_eq!(frames.len(), rows.len() / 12);
     for f in &frames {
@@ -332,8 +334,10 @@ fn run_writes_frame_pngs_and_a_gif_and_render_a_still() {
     );
     assert!(out.status.success(), "{}", stderr(&out));
     // 1 s at dt = 2e-4 is 5000 steps: frames 0 to 5.
-    let pngs = std::fs::read_dir(dir.join("f")).unwrap().count();
-    assert_eq!(pngs, 6);
+    let mut names = file_names(&dir.join("f"));
+    names.sort();
+    assert_eq!(names.len(), 7, "{names:?}");
+    assert_eq!(names[0], ".hooke-frames");
     let first = image::open(dir.join("f/frame-00000.png"))
         .unwrap()
         .to_rgba8();
@@ -487,7 +491,12 @@ fn an_obj_export_writes_a_frame_file_per_frame_with_named_objects() {
     names.sort();
     assert_eq!(
         names,
-        ["frame-00000.obj", "frame-00001.obj", "frame-00002.obj"]
+        [
+            ".hooke-frames",
+            "frame-00000.obj",
+            "frame-00001.obj",
+            "frame-00002.obj"
+        ]
     );
     let text = std::fs::read_to_string(dir.join("objs/frame-00002.obj")).unwrap();
     let objects: Vec<&str> = text.lines().filter(|l| l.starts_with("o ")).collect();

@@ -326,7 +326,33 @@ fn a_frame_folder_is_held_by_one_run_at_a_time() {
     );
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(temporaries(&dir), Vec::<std::path::PathBuf>::new());
-    assert_eq!(file_names(&dir.join("f")), ["frame-00000.png"]);
+    let mut names = file_names(&dir.join("f"));
+    names.sort();
+    assert_eq!(names, [".hooke-frames", "frame-00000.png"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 54: a folder of someone else's frames (a video's, extracted as `frame-%05d.png`)
+/// is not Hooke's to empty: a run into it is refused, naming a file, and nothing in it is
+/// touched; a folder export likewise.
+#[test]
+fn a_users_frames_are_never_removed() {
+    let dir = scratch("users-frames");
+    for (folder, args) in [
+        ("f2", vec!["--frames", "f2"]),
+        ("e2", vec!["--export", "e2/", "--format", "ply"]),
+    ] {
+        std::fs::create_dir_all(dir.join(folder)).unwrap();
+        let mine = dir.join(folder).join("frame-00500.png");
+        std::fs::write(&mine, "mine").unwrap();
+        let mut all = vec!["run", "chain", "--steps", "100", "--every", "10"];
+        all.extend(args);
+        let out = hooke(&all, &dir);
+        assert_eq!(out.status.code(), Some(1), "{all:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains("frame-00500.png"), "{}", stderr(&out));
+        assert_eq!(std::fs::read_to_string(&mine).unwrap(), "mine");
+        assert_eq!(file_names(&dir.join(folder)), ["frame-00500.png"]);
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -65,11 +65,20 @@ fn look(at: &Path) -> (bool, bool, u64, Option<std::path::PathBuf>) {
 /// created first) holds each kind of plant in turn, and checks that the run refused with the
 /// path named, and left the plant and the victim as they were.
 fn refused_at(case: &str, out: &str, name: &str, args: &[&str]) {
+    refused_in(case, (out, false), name, args);
+}
+
+/// [`refused_at`] with the output folder `out` marked as a folder of hooke's frames when
+/// `marked`: frames there are hooke's to replace, but never through a plant.
+fn refused_in(case: &str, (out, marked): (&str, bool), name: &str, args: &[&str]) {
     for kind in PLANTS {
         let dir = scratch(&format!("planted-{case}-{kind:?}"));
         let victim = dir.join("victim.txt");
         std::fs::write(&victim, "precious").unwrap();
         std::fs::create_dir_all(dir.join(out)).unwrap();
+        if marked {
+            std::fs::write(dir.join(out).join(".hooke-frames"), "hooke").unwrap();
+        }
         let at = dir.join(out).join(name);
         plant(kind, &at, &victim);
         let before = look(&at);
@@ -111,12 +120,15 @@ fn planted_frames_exports_stills_and_report_files_are_never_written_through() {
     let frames = [
         "run", "chain", "--steps", "10", "--every", "5", "--frames", "fr",
     ];
-    refused_at("frame", "fr", "frame-00001.png", &frames);
-    for (format, name) in [("ply", "frame-00000.ply"), ("obj", "frame-00002.obj")] {
-        let args = [
-            "run", "chain", "--steps", "10", "--every", "5", "--export", "ex/", "--format", format,
-        ];
-        refused_at(&format!("export-{format}"), "ex", name, &args);
+    for marked in [false, true] {
+        refused_in("frame", ("fr", marked), "frame-00001.png", &frames);
+        for (format, name) in [("ply", "frame-00000.ply"), ("obj", "frame-00002.obj")] {
+            let args = [
+                "run", "chain", "--steps", "10", "--every", "5", "--export", "ex/", "--format",
+                format,
+            ];
+            refused_in(&format!("export-{format}"), ("ex", marked), name, &args);
+        }
     }
     refused_at("demo", "dm", "3-jello-cube.png", &["demo", "--out", "dm"]);
     refused_at(

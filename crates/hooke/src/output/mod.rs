@@ -107,26 +107,100 @@ pub fn check_output_folder(dir: &Path, flag: &str) -> Result<()> {
     Ok(())
 }
 
+/// The file that says a folder holds Hooke's frames: written when Hooke first takes a
+/// folder for frames, so that a later run may remove that run's frames (and only in a
+/// folder that carries it).
+pub const FRAMES_MARKER: &str = ".hooke-frames";
+
+/// What the marker holds.
+const FRAMES_MARKER_TEXT: &str = "hooke: this folder holds frames written by hooke \
+(frame-NNNNN.png, .ply, .obj); a later run into it replaces them\n";
+
+/// Creates folder `dir` (given with option `flag`) and any missing folders above it; when
+/// that fails because something on the way is not a folder (a file, a link to nothing),
+/// says which.
+pub fn create_folder(dir: &Path, flag: &str) -> Result<()> {
+    let Err(e) = std::fs::create_dir_all(dir) else {
+        return Ok(());
+    };
+    for above in dir.ancestors().filter(|a| !a.as_os_str().is_empty()) {
+        let Ok(meta) = std::fs::symlink_metadata(above) else {
+            continue;
+        };
+        if meta.file_type().is_symlink() && std::fs::metadata(above).is_err() {
+            let target = std::fs::read_link(above).unwrap_or_default();
+            bail_output!(
+                "{flag} {}: cannot create the folder: {} is a symbolic link to nothing ({}); \
+                 point it at a folder, or choose another path",
+                dir.display(),
+                above.display(),
+                target.display()
+            );
+        }
+        if !meta.is_dir() && !meta.file_type().is_symlink() {
+            bail_output!(
+                "{flag} {}: cannot create the folder: {} is a file, not a folder",
+                dir.display(),
+                above.display()
+            );
+        }
+    }
+    Err(crate::Error::from(e).context(format!(
+        "{flag} {}: cannot create the folder",
+        dir.display()
+    )))
+}
+
 /// Prepares folder `dir` (given with option `flag`) for numbered frames `frame-NNNNN.ext`:
 /// creates it if missing, refuses a file, takes it for this run (refused while another run
 /// holds it), and removes the frames an earlier run left there, so that the folder holds
 /// exactly this run's frames. Returns the folder's lock, held while the frames are written,
 /// and how many frames were removed.
+///
+/// Only a folder marked as Hooke's ([`FRAMES_MARKER`]) has frames removed: a folder without
+/// the marker is taken (and marked) only when nothing in it is named like a frame, so a
+/// file Hooke did not write — a video's frames extracted as `frame-%05d.png` — is never
+/// removed or replaced; the run is refused instead, naming it.
 pub fn prepare_frame_folder(dir: &Path, flag: &str, ext: &str) -> Result<(FolderLock, usize)> {
     check_output_folder(dir, flag)?;
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("{flag} {}: cannot create the folder", dir.display()))?;
+    create_folder(dir, flag)?;
     let lock = FolderLock::take(dir, flag)?;
+    let marker = dir.join(FRAMES_MARKER);
+    check_named(&marker, flag)?;
+    let marked = std::fs::symlink_metadata(&marker).is_ok();
     let entries =
         std::fs::read_dir(dir).with_context(|| format!("{flag} {}: cannot read", dir.display()))?;
     // Every stale frame is looked at before any is removed: a link, a second name or a
     // device under a frame's name refuses the run and leaves the folder as it was.
     let mut stale = Vec::new();
+    let mut foreign = Vec::new();
     for entry in entries.flatten() {
-        if is_frame_name(&entry.file_name().to_string_lossy(), ext) {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if !marked && is_any_frame_name(&name) {
+            foreign.push(name);
+        } else if is_frame_name(&name, ext) {
             named::check_named(&entry.path(), flag)?;
             stale.push(entry.path());
         }
+    }
+    if !foreign.is_empty() {
+        foreign.sort();
+        bail_output!(
+            "{flag} {}: holds {} named like hooke's frames ({}{}) but is not a folder hooke \
+             wrote frames into (it has no {FRAMES_MARKER} marker), so they are not hooke's to \
+             replace; choose a new or empty folder, or move them away",
+            dir.display(),
+            if foreign.len() == 1 {
+                "a file".to_string()
+            } else {
+                format!("{} files", foreign.len())
+            },
+            foreign[0],
+            if foreign.len() > 1 { ", …" } else { "" }
+        );
+    }
+    if !marked {
+        write_named(&marker, flag, FRAMES_MARKER_TEXT.as_bytes())?;
     }
     for path in &stale {
         std::fs::remove_file(path)
@@ -141,6 +215,12 @@ pub fn prepare_frame_folder(dir: &Path, flag: &str, ext: &str) -> Result<(Folder
 /// `frame-00042.ext`.
 pub fn frame_name(frame: u64, ext: &str) -> String {
     format!("frame-{frame:05}.{ext}")
+}
+
+/// Whether `name` is `frame-` followed by five or more digits, a dot and any extension.
+fn is_any_frame_name(name: &str) -> bool {
+    name.rsplit_once('.')
+        .is_some_and(|(_, ext)| !ext.is_empty() && is_frame_name(name, ext))
 }
 
 pub(crate) fn is_frame_name(name: &str, ext: &str) -> bool {
@@ -163,6 +243,39 @@ mod tests {
         assert!(!is_frame_name("frame-00000.obj", "png"));
         assert!(!is_frame_name("my-frame-00000.png", "png"));
         assert_eq!(frame_name(7, "obj"), "frame-00007.obj");
+        assert!(is_any_frame_name("frame-00500.png"));
+        assert!(is_any_frame_name("frame-00500.jpg"));
+        assert!(!is_any_frame_name("frame-00500."));
+        assert!(!is_any_frame_name("frames.txt"));
+    }
+
+    #[test]
+    fn a_users_file_named_like_a_frame_is_never_removed() {
+        let dir = std::env::temp_dir().join(format!("hooke-users-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mine = dir.join("frame-00500.png");
+        std::fs::write(&mine, b"mine").unwrap();
+        let e = prepare_frame_folder(&dir, "--frames", "png").unwrap_err();
+        assert!(format!("{e:#}").contains("frame-00500.png"), "{e:#}");
+        assert!(format!("{e:#}").contains(FRAMES_MARKER), "{e:#}");
+        // A frame of another format is a user's file too.
+        let e = prepare_frame_folder(&dir, "--export", "ply").unwrap_err();
+        assert!(format!("{e:#}").contains("frame-00500.png"), "{e:#}");
+        assert_eq!(std::fs::read(&mine).unwrap(), b"mine");
+        assert!(!dir.join(FRAMES_MARKER).exists());
+        // A folder hooke marked is hooke's: its frames are replaced by the next run.
+        std::fs::remove_file(&mine).unwrap();
+        std::fs::write(dir.join("notes.txt"), b"kept").unwrap();
+        let (lock, removed) = prepare_frame_folder(&dir, "--frames", "png").unwrap();
+        assert_eq!(removed, 0);
+        assert!(dir.join(FRAMES_MARKER).exists());
+        std::fs::write(dir.join("frame-00000.png"), b"a frame").unwrap();
+        drop(lock);
+        let (lock, removed) = prepare_frame_folder(&dir, "--frames", "png").unwrap();
+        assert_eq!(removed, 1);
+        assert_eq!(std::fs::read(dir.join("notes.txt")).unwrap(), b"kept");
+        drop(lock);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
