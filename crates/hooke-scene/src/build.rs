@@ -5,7 +5,7 @@ use crate::body::{build_body, pin_motion};
 use crate::colliders::{build_collider, response};
 use crate::contact_surface::body_surface;
 use crate::error::{BuildError, invalid};
-use crate::limits::{DT_RANGE, MAX_PARTICLES, MAX_PENALTY, MAX_STEPS, particle_count};
+use crate::limits::{MAX_PARTICLES, MAX_PENALTY, MAX_STEPS, particle_count};
 use crate::scene::{Body, ColliderGeometry, Scene};
 use crate::spec::*;
 use hooke_core::{AeroSurface, Air, Gust, Num, PinMotion, SANE_BOUND, StartInside};
@@ -16,19 +16,7 @@ impl SceneSpec {
     /// Steps in a full run, from `steps` or `duration / dt` rounded to the nearest step.
     pub fn total_steps(&self) -> Result<u64, BuildError> {
         let sim = &self.simulation;
-        if !DT_RANGE.contains(&sim.dt.get()) {
-            return Err(invalid(
-                "simulation.dt",
-                format!(
-                    "{} s is a step no solver here can represent: its square and inverse \
-                     square leave the numbers' range in the stiffness and inertia terms; \
-                     expected {:e} to {:e} s",
-                    Num(sim.dt.get()),
-                    DT_RANGE.start(),
-                    DT_RANGE.end()
-                ),
-            ));
-        }
+        crate::limits::check_dt(sim.dt.get())?;
         match (sim.steps, sim.duration) {
             (Some(_), Some(_)) => Err(invalid(
                 "simulation",
@@ -71,6 +59,8 @@ impl SceneSpec {
     /// folder). The steps, in order: the run's length and cadence, the bodies (particles,
     /// springs, surfaces, air triangles), the colliders, the force field, then the model.
     pub fn build(&self, base: &Path) -> Result<Scene, BuildError> {
+        crate::ranges::check_ranges(self)?;
+        self.check_drag()?;
         let (steps, every) = self.run_length()?;
         let built = self.build_bodies()?;
         let centroid = if built.particles.is_empty() {
@@ -83,6 +73,7 @@ impl SceneSpec {
             springs: built.springs,
             gravity: vec3(&self.simulation.gravity),
             drag: self.simulation.drag.get(),
+            mass_drag: self.simulation.mass_drag.get(),
             field: self.build_field()?,
             colliders,
             attachments: Vec::new(),
@@ -106,7 +97,9 @@ impl SceneSpec {
         );
         let pushed_out = simulation.push_out_start().map_err(|e| {
             let particle = match &e {
-                StartInside::Through(i, ..) | StartInside::Stuck(i, ..) => *i,
+                StartInside::Through(i, ..)
+                | StartInside::Deformed(i, ..)
+                | StartInside::Stuck(i, ..) => *i,
             };
             let b = built
                 .bodies
@@ -220,6 +213,56 @@ impl SceneSpec {
             out.surfaces.push(surface);
         }
         Ok(())
+    }
+
+    /// Refuses `[simulation] drag` with a body given as a material: a drag per particle
+    /// changes such a body with its resolution, which a material promises not to do.
+    fn check_drag(&self) -> Result<(), BuildError> {
+        let drag = self.simulation.drag.get();
+        let Some((b, body)) = self
+            .bodies
+            .iter()
+            .enumerate()
+            .find(|(_, b)| b.material.is_some())
+        else {
+            return Ok(());
+        };
+        if drag == 0.0 {
+            return Ok(());
+        }
+        // The mass drag that gives this body's particles, on average, the same drag.
+        let particles = crate::limits::particle_count(&body.shape)
+            .unwrap_or(1)
+            .max(1) as f64;
+        let mass = body
+            .material
+            .as_ref()
+            .and_then(|m| m.resolve(&format!("body[{b}].material")).ok())
+            .zip(match body.shape {
+                ShapeSpec::Grid { size, spacing } => Some(
+                    (size[0].max(2) - 1) as f64
+                        * (size[1].max(2) - 1) as f64
+                        * spacing.get().powi(2),
+                ),
+                _ => None,
+            })
+            .map(|(m, area)| m.density * area / particles);
+        let advice = mass.map_or(String::new(), |m| {
+            format!(
+                " (`mass_drag = {}` gives this resolution's particles the same drag on average)",
+                hooke_core::Approx(drag / m)
+            )
+        });
+        Err(invalid(
+            "simulation.drag",
+            format!(
+                "{} N·s/m acts on every particle, so body[{b}] '{}', given as a material, would \
+                 feel more drag the finer its grid; give `mass_drag` in N·s/m per kg (1/s) \
+                 instead{advice}, or air (`[simulation] air`), whose drag is per area",
+                Num(drag),
+                body.name
+            ),
+        ))
     }
 
     /// The colliders in file order, with their geometry for drawing; an inclined plane is

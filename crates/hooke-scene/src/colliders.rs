@@ -58,7 +58,7 @@ fn mesh_text(path: &str, base: &Path) -> Result<(String, PathBuf), MeshError> {
 }
 
 /// `shape` moved by `motion` about its pivot: a mesh's placed origin (`translate`), a
-/// box's or a cylinder's centre. A ground or a plane cannot move.
+/// box's, a cylinder's or a sphere's centre. A ground or a plane cannot move.
 pub(crate) fn moving(
     shape: Box<dyn Collider>,
     spec: &ColliderShapeSpec,
@@ -68,7 +68,7 @@ pub(crate) fn moving(
     let Some(pivot) = spec.pivot() else {
         return Err(invalid(
             format!("{key}.motion"),
-            "a ground or a plane cannot move: only a mesh, a box or a cylinder can",
+            "a ground or a plane cannot move: only a mesh, a box, a cylinder or a sphere can",
         ));
     };
     let keys = keyframes(motion, &format!("{key}.motion"))?;

@@ -33,6 +33,7 @@ pub mod generators;
 mod limits;
 pub mod material;
 mod overrides;
+mod ranges;
 mod scene;
 mod scene_toml;
 pub mod spec;

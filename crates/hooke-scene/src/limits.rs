@@ -36,9 +36,23 @@ pub const MAX_AIR_DENSITY: f64 = 2.0e4;
 /// penalty energy of a deep contact leaves the range of the numbers.
 pub const MAX_PENALTY: f64 = 1.0e12;
 
-/// The range of step sizes a scene may take, seconds. Every integrator divides by `dt²`
-/// (block descent's inertia `m/dt²`, implicit Euler's `M/dt`, the stable-step estimates),
-/// and the contact and stability figures multiply by it: outside this range those numbers
-/// leave what doubles hold with room to spare, and no scene means such a step (a
-/// femtosecond, or a step of over a quarter of an hour).
-pub const DT_RANGE: std::ops::RangeInclusive<f64> = 1e-15..=1e3;
+/// The range of step sizes a scene may take, seconds (the core's
+/// [`hooke_core::integrator::DT_RANGE`], where the reason is given).
+pub const DT_RANGE: std::ops::RangeInclusive<f64> = hooke_core::integrator::DT_RANGE;
+
+/// Refuses a step outside [`DT_RANGE`], naming `simulation.dt`.
+pub(crate) fn check_dt(dt: f64) -> Result<(), crate::BuildError> {
+    if DT_RANGE.contains(&dt) {
+        return Ok(());
+    }
+    Err(crate::error::invalid(
+        "simulation.dt",
+        format!(
+            "{} s is a step no solver here can represent: its square and inverse square leave \
+             the numbers' range in the stiffness and inertia terms; expected {:e} to {:e} s",
+            hooke_core::Num(dt),
+            DT_RANGE.start(),
+            DT_RANGE.end()
+        ),
+    ))
+}

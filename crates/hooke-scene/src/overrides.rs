@@ -37,7 +37,8 @@ impl std::str::FromStr for TableOverride {
 pub struct Overrides {
     /// Replace the integrator.
     pub integrator: Option<hooke_core::Integrator>,
-    /// Replace the step size (seconds).
+    /// Replace the step size (seconds). Without [`Overrides::every`], the frame cadence is
+    /// scaled to keep the scene's frame interval in time (at least a frame per step).
     pub dt: Option<f64>,
     /// Replace the run length with this many steps.
     pub steps: Option<u64>,
@@ -57,7 +58,19 @@ impl Overrides {
             sim.integrator = IntegratorName(i);
         }
         if let Some(dt) = self.dt {
+            let was = sim.dt.get();
             sim.dt = Positive::try_from(dt).map_err(|m| invalid("simulation.dt", m))?;
+            crate::limits::check_dt(dt)?;
+            // A new step keeps the scene's frame interval in time, unless the frames are
+            // given too: 40 steps of 2.5e-4 s are one step of 1/60 s, not 40.
+            if self.every.is_none() {
+                let every = (sim.every as f64 * was / dt).round();
+                sim.every = if every.is_finite() && every >= 1.0 {
+                    (every as u64).min(crate::limits::MAX_STEPS)
+                } else {
+                    1
+                };
+            }
         }
         if let Some(steps) = self.steps {
             sim.steps = Some(steps);
@@ -73,6 +86,25 @@ impl Overrides {
         }
         if let Some(table) = &self.table {
             let mut replaced = false;
+            // A collider that moves by keys (a puck swept through a cloth) is no table: put
+            // in its place a table would keep its keys but not its shape or its path's sense.
+            if let Some((k, _)) = spec.colliders.iter().enumerate().find(|(_, c)| {
+                c.motion.is_some()
+                    && matches!(
+                        c.shape,
+                        ColliderShapeSpec::Mesh { .. } | ColliderShapeSpec::Cylinder { .. }
+                    )
+            }) {
+                return Err(invalid(
+                    "table",
+                    format!(
+                        "collider[{k}] moves by keys (it is no still table), and a \
+                         table swapped in would not take its shape, place or path; write the \
+                         scene out (hooke scene {}) and change the collider there",
+                        spec.name
+                    ),
+                ));
+            }
             for c in &mut spec.colliders {
                 if matches!(
                     c.shape,

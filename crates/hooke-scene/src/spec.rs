@@ -155,9 +155,15 @@ pub struct SimulationSpec {
     /// Gravitational acceleration in m/s² (default `[0, -9.81, 0]`).
     #[serde(default = "default_gravity")]
     pub gravity: [Finite; 3],
-    /// Linear drag on every particle in N·s/m (default 0).
+    /// Linear drag on every particle in N·s/m per particle, the course's convention
+    /// (default 0): a body's drag then depends on how many particles it has, so a body
+    /// given as a `material` takes `mass_drag` instead.
     #[serde(default = "zero", skip_serializing_if = "is_zero")]
     pub drag: NonNegative,
+    /// Linear drag in N·s/m per kilogram of particle (1/s; force `-mass_drag m v`), the
+    /// same for a body at any resolution (default 0).
+    #[serde(default = "zero", skip_serializing_if = "is_zero")]
+    pub mass_drag: NonNegative,
     /// The air that bodies with a surface (grids, lattices) move in: drag and lift per
     /// triangle (docs/physics.md §1, "Air"). Absent: vacuum.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -43,6 +43,44 @@ impl Scene {
                 ));
             }
         }
+        for (b, spec) in self.spec.bodies.iter().enumerate() {
+            let Some(keys) = spec.pin_motion.as_ref().and_then(|m| m.keyframes().ok()) else {
+                continue;
+            };
+            // The pins sit where the keys put them at t = 0 from the first step on.
+            let (translate, rotate) = keys.at(0.0);
+            if translate != Vec3::zeros() || rotate != Vec3::zeros() {
+                let first = keys.keys()[0].t;
+                said.push(format!(
+                    "body[{b}] '{}': its pin_motion puts the pins {} m away{} at t = 0{}, so \
+                     they jump there at the first step and pull the body after them; start \
+                     the keys with {{ t = 0, translate = [0, 0, 0] }}",
+                    spec.name,
+                    hooke_core::Approx(translate.norm()),
+                    if rotate != Vec3::zeros() {
+                        format!(
+                            ", turned by ({}°, {}°, {}°)",
+                            hooke_core::Approx(rotate.x),
+                            hooke_core::Approx(rotate.y),
+                            hooke_core::Approx(rotate.z)
+                        )
+                    } else {
+                        String::new()
+                    },
+                    if first > 0.0 {
+                        format!(
+                            " (its first key, at t = {} s, holds before it)",
+                            hooke_core::Approx(first)
+                        )
+                    } else if keys.keys().iter().all(|k| k.t < 0.0) {
+                        " (every key is before t = 0: the last one's pose holds from the start)"
+                            .to_string()
+                    } else {
+                        String::new()
+                    }
+                ));
+            }
+        }
         for moved in &self.pushed_out {
             said.push(format!(
                 "{} particle{} started inside collider[{}] ({}) or nearer it than their \

@@ -36,6 +36,7 @@ pub fn cloth(n: usize) -> SceneSpec {
             every: WORKLOAD_STEPS,
             gravity: [Finite::of(0.0), Finite::of(-9.81), Finite::of(0.0)],
             drag: NonNegative::of(0.0),
+            mass_drag: NonNegative::of(0.0),
             air: None,
         },
         bodies: vec![BodySpec {

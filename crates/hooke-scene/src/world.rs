@@ -403,6 +403,7 @@ impl World {
                 every: self.every,
                 gravity: [Finite::of(0.0); 3],
                 drag: NonNegative::of(0.0),
+                mass_drag: NonNegative::of(0.0),
                 air: None,
             },
             bodies: vec![BodySpec {

@@ -90,11 +90,12 @@ pub(super) fn step(
     }
 
     // Block-Jacobi preconditioner: the inverse of each particle's diagonal block.
-    let diagonal_shift = dt * model.drag;
+    // Each particle's mass and drag on the diagonal.
+    let inertia = |m: f64| m + dt * model.drag_on(m);
     buffers.preconditioner.clear();
     buffers
         .preconditioner
-        .extend((0..n).map(|i| Sym3::default().plus_identity(p.mass[i] + diagonal_shift)));
+        .extend((0..n).map(|i| Sym3::default().plus_identity(inertia(p.mass[i]))));
     for (k, c) in buffers.system.iter().enumerate() {
         let [i, j] = asm.ends(k);
         buffers.preconditioner[i] = buffers.preconditioner[i].plus(c);
@@ -118,7 +119,7 @@ pub(super) fn step(
             if fixed(i) {
                 Vec3::zeros()
             } else {
-                from[i] * (mass[i] + diagonal_shift) + row
+                from[i] * inertia(mass[i]) + row
             }
         });
     };
@@ -164,7 +165,7 @@ pub(super) fn step(
     let residual: Vec3 = r.iter().sum();
     let free_mass: f64 = (0..n)
         .filter(|&i| !fixed(i))
-        .map(|i| p.mass[i] + diagonal_shift)
+        .map(|i| inertia(p.mass[i]))
         .sum();
     if free_mass > 0.0 {
         let shift = residual / free_mass;

@@ -31,8 +31,12 @@ pub struct Model {
     pub springs: Vec<Spring>,
     /// Gravitational acceleration in m/s², applied as the force `m g`.
     pub gravity: Vec3,
-    /// Linear drag in N·s/m (force `-drag v` on every particle); zero disables it.
+    /// Linear drag in N·s/m per particle (force `-drag v` on every particle, the course's
+    /// convention); zero disables it.
     pub drag: f64,
+    /// Linear drag in N·s/m per kilogram (force `-mass_drag m v`): the same for a body at
+    /// any resolution; zero disables it.
+    pub mass_drag: f64,
     /// An optional force field (jello worlds).
     pub field: Option<ForceField>,
     /// Colliders, each with its response.
@@ -87,10 +91,21 @@ impl Model {
     /// tests of [`Model::external_force`], whose result it equals to the bit.
     pub fn gravity_only(&self) -> bool {
         self.field.is_none()
-            && self.drag == 0.0
+            && !self.has_drag()
             && self.air.is_none()
             && self.attachments.is_empty()
             && self.colliders.iter().all(|c| !c.response.is_force())
+    }
+
+    /// Whether any drag acts.
+    pub fn has_drag(&self) -> bool {
+        self.drag != 0.0 || self.mass_drag != 0.0
+    }
+
+    /// The drag coefficient on a particle of `mass` kg, N·s/m: `drag + mass_drag · mass`.
+    #[inline]
+    pub fn drag_on(&self, mass: f64) -> f64 {
+        self.drag + self.mass_drag * mass
     }
 
     /// Whether any collider has a velocity-level response (restitution, stick), which
@@ -188,7 +203,7 @@ impl Model {
     /// is `m g + springs`, to the bit.
     pub(crate) fn gravity_only_near(&self, near: Near) -> bool {
         self.field.is_none()
-            && self.drag == 0.0
+            && !self.has_drag()
             && self.attachments.is_empty()
             && self
                 .colliders
@@ -218,8 +233,8 @@ impl Model {
         if let Some(field) = &self.field {
             f += field.sample(x);
         }
-        if self.drag != 0.0 {
-            f -= v * self.drag;
+        if self.has_drag() {
+            f -= v * self.drag_on(mass);
         }
         let mut margin = None;
         for (k, slot) in self.colliders.iter().enumerate() {

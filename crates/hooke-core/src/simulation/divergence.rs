@@ -102,8 +102,21 @@ pub(crate) fn check(end: StepEnd<'_>) -> Result<(), Divergence> {
         dt: end.dt,
         stable_dt,
         step_stable_dt,
-        suggested_dt: 0.5 * stable_dt.min(step_stable_dt).min(end.dt),
+        suggested_dt: suggested(stable_dt, end.dt),
     })
+}
+
+/// The step to advise after a divergence of a run at `dt` whose start's stable estimate is
+/// `stable_dt`: half the smaller, never below the shortest step a scene may take
+/// ([`crate::integrator::DT_RANGE`]; zero when even that is too long). The estimate of the
+/// state a diverging step started from is no guide: that state has often run away already.
+pub(crate) fn suggested(stable_dt: f64, dt: f64) -> f64 {
+    let half = 0.5 * stable_dt.min(dt);
+    if half >= *crate::integrator::DT_RANGE.start() {
+        half
+    } else {
+        0.0
+    }
 }
 
 /// The lowest-numbered particle in a bad state, and what is wrong with it.
@@ -121,12 +134,26 @@ fn first_bad(p: &Particles) -> Option<(usize, String)> {
 }
 
 impl Divergence {
+    /// The advice to take a step of [`Divergence::suggested_dt`], or, when no step Hooke
+    /// accepts would do, to look at the scene instead.
+    fn smaller(&self) -> String {
+        if self.suggested_dt > 0.0 {
+            format!("dt = {:.3e} s", self.suggested_dt)
+        } else {
+            format!(
+                "no step Hooke accepts (down to {:e} s) would be stable: the scene's stiffness \
+                 against its masses is out of reach (see hooke check)",
+                crate::integrator::DT_RANGE.start()
+            )
+        }
+    }
+
     fn message(&self) -> String {
         use crate::Num;
         let head = format!(
             "diverged at step {} (t = {} s): particle {} {}",
             self.step,
-            Num(self.time),
+            crate::Approx(self.time),
             self.particle,
             self.what
         );
@@ -145,21 +172,21 @@ impl Divergence {
                 "the {} step dt = {} s is within its stable estimate of {:.3e} s at the run's \
                  start (as hooke check says), but not the {:.3e} s of the state the step started \
                  from, which had already run away: look for forces that stiffen as the state \
-                 moves (a strong wind, a stiff penalty collider); dt = {:.3e} s may help",
+                 moves (a strong wind, a stiff penalty collider); {} may help",
                 self.integrator,
                 Num(self.dt),
                 self.stable_dt,
                 self.step_stable_dt,
-                self.suggested_dt
+                self.smaller()
             )
         } else if self.dt > self.stable_dt {
             format!(
                 "the {} step dt = {} s exceeds its stable estimate of {:.3e} s at the run's start \
-                 (as hooke check says){here}; use dt = {:.3e} s or smaller",
+                 (as hooke check says){here}; use {} or smaller",
                 self.integrator,
                 Num(self.dt),
                 self.stable_dt,
-                self.suggested_dt
+                self.smaller()
             )
         } else {
             let estimate = if self.stable_dt.is_finite() {
@@ -171,10 +198,10 @@ impl Divergence {
                 "the {} step dt = {} s is within {estimate}, so the step size alone does not \
                  explain this: look for a very stiff or degenerate spring, a stiff penalty \
                  collider, a strong force field or an extreme initial state; a smaller step, \
-                 dt = {:.3e} s, may still help",
+                 {}, may still help",
                 self.integrator,
                 Num(self.dt),
-                self.suggested_dt
+                self.smaller()
             )
         };
         format!("{head}; {advice}")

@@ -148,7 +148,6 @@ fn real_interval(integrator: Integrator) -> f64 {
 /// it summed (twice each spring's `kd`, as Gershgorin's row sum counts both ends), over its
 /// mass; the largest.
 fn damping_rate(model: &Model, p: &Particles) -> f64 {
-    let n = p.len();
     let penalty_dc: f64 = model
         .colliders
         .iter()
@@ -157,7 +156,11 @@ fn damping_rate(model: &Model, p: &Particles) -> f64 {
             _ => 0.0,
         })
         .sum();
-    let mut row = vec![model.drag + penalty_dc; n];
+    let mut row: Vec<f64> = p
+        .mass
+        .iter()
+        .map(|&m| model.drag_on(m) + penalty_dc)
+        .collect();
     for s in &model.springs {
         row[s.i as usize] += 2.0 * s.kd;
         row[s.j as usize] += 2.0 * s.kd;

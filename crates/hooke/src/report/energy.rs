@@ -44,12 +44,10 @@ fn damping_power(scene: &Scene) -> f64 {
             s.kd * along * along
         })
         .sum();
-    let drag: f64 =
-        p.v.iter()
-            .zip(&p.inv_mass)
-            .filter(|(_, inv)| **inv != 0.0)
-            .map(|(v, _)| model.drag * v.norm_squared())
-            .sum();
+    let drag: f64 = (0..p.len())
+        .filter(|&i| p.inv_mass[i] != 0.0)
+        .map(|i| model.drag_on(p.mass[i]) * p.v[i].norm_squared())
+        .sum();
     springs + drag
 }
 

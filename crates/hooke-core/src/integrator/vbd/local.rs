@@ -184,9 +184,10 @@ impl Local<'_> {
             gaps: Gaps::default(),
         };
         let model = self.model;
-        if model.drag != 0.0 {
-            b.f -= moved * (model.drag / dt);
-            b.h = b.h.plus_identity(model.drag / dt);
+        if model.has_drag() {
+            let drag = model.drag_on(self.mass[i]) / dt;
+            b.f -= moved * drag;
+            b.h = b.h.plus_identity(drag);
         }
         let mine = if springs { self.graph.of(i) } else { &[] };
         for nb in mine {
