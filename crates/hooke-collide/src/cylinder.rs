@@ -118,6 +118,38 @@ impl Collider for Cylinder {
         sink(contact);
     }
 
+    /// Whether the part of the segment between the top and bottom planes comes nearer the
+    /// axis than the radius.
+    fn segment_meets(&self, a: &Vec3, b: &Vec3) -> bool {
+        let (top, bottom) = (self.center.y, self.center.y - self.thickness);
+        let ab = b - a;
+        // The segment's span of parameters within the slab.
+        let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
+        if ab.y == 0.0 {
+            if !(bottom < a.y && a.y < top) {
+                return false;
+            }
+        } else {
+            let (u, v) = ((bottom - a.y) / ab.y, (top - a.y) / ab.y);
+            t0 = t0.max(u.min(v));
+            t1 = t1.min(u.max(v));
+            if t0 >= t1 {
+                return false;
+            }
+        }
+        // The nearest approach to the axis over that span, in the x-z plane.
+        let (px, pz) = (a.x - self.center.x, a.z - self.center.z);
+        let (dx, dz) = (ab.x, ab.z);
+        let len2 = dx * dx + dz * dz;
+        let t = if len2 > 0.0 {
+            (-(px * dx + pz * dz) / len2).clamp(t0, t1)
+        } else {
+            t0
+        };
+        let (x, z) = (px + dx * t, pz + dz * t);
+        x * x + z * z < self.radius * self.radius
+    }
+
     /// Whether the box, grown by `margin` (and a little for rounding), meets the solid's
     /// bounds.
     fn may_touch(&self, lo: &Vec3, hi: &Vec3, margin: f64) -> bool {
@@ -163,5 +195,36 @@ impl Collider for Cylinder {
 
     fn has_features(&self) -> bool {
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TABLE: Cylinder = Cylinder {
+        center: Vec3::new(0.0, 1.0, 0.0),
+        radius: 0.5,
+        thickness: 0.05,
+    };
+
+    #[test]
+    fn a_segment_meets_the_disc_only_through_its_inside() {
+        let meets = |a: [f64; 3], b: [f64; 3]| {
+            TABLE.segment_meets(&Vec3::new(a[0], a[1], a[2]), &Vec3::new(b[0], b[1], b[2]))
+        };
+        // Down through the top, and sideways through the rim's thickness.
+        assert!(meets([0.1, 1.2, 0.0], [0.1, 0.8, 0.0]));
+        assert!(meets([-0.8, 0.98, 0.0], [0.8, 0.98, 0.1]));
+        // A cloth edge over the rim, from the top to the side: through the corner.
+        assert!(meets([0.45, 1.005, 0.0], [0.55, 0.94, 0.0]));
+        // Above the top, beside the side, below the bottom: not.
+        assert!(!meets([-0.8, 1.01, 0.0], [0.8, 1.01, 0.0]));
+        assert!(!meets([0.6, 1.2, 0.0], [0.6, 0.8, 0.0]));
+        assert!(!meets([0.0, 0.9, 0.0], [0.3, 0.94, 0.0]));
+        // Steep past the rim without entering: from above the top outside the radius.
+        assert!(!meets([0.52, 1.1, 0.0], [0.6, 0.9, 0.0]));
+        // Each end inside.
+        assert!(meets([0.0, 0.99, 0.0], [0.0, 0.99, 0.0]));
     }
 }

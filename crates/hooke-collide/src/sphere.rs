@@ -1,15 +1,15 @@
 //! A solid ball: the analytic sphere collider.
 
 use crate::bounds::{boxes_meet, touch_reach};
-use hooke_core::{Collider, Contact, Vec3};
+use hooke_core::{Collider, Contact, Feature, Vec3};
 
 /// A solid ball of radius `R` about `C`: inside when `|p − C| < R`; the contact is with the
 /// nearest surface point `C + R n`, `n = (p − C)/|p − C|` (straight up at the centre itself).
 ///
-/// Smooth, so it has no features: a cloth triangle of edge `l` whose corners keep a
-/// thickness `h` from the ball comes within `h − l²/(8R)` of it between them, which stays
-/// positive while `l² < 8 R h` (for a 5 mm thickness and 4 cm edges, a ball of radius 4 cm
-/// or more).
+/// Smooth, yet a cloth triangle of edge `l` whose corners keep a thickness `h` from the ball
+/// comes within `h − l²/(8R)` of it between them: a stretched cloth's edges dip into a small
+/// ball. So the ball is also a feature ([`Feature::Ball`]): its point nearest each triangle
+/// near it, kept a thickness from the triangle as a rim or an edge is.
 ///
 /// ```
 /// use hooke_collide::Sphere;
@@ -62,6 +62,33 @@ impl Collider for Sphere {
                 point: self.center + n * self.radius,
             });
         }
+    }
+
+    /// Whether the segment comes nearer the centre than the radius.
+    fn segment_meets(&self, a: &Vec3, b: &Vec3) -> bool {
+        let ab = b - a;
+        let t = if ab.norm_squared() > 0.0 {
+            ((self.center - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (a + ab * t - self.center).norm() < self.radius
+    }
+
+    /// The ball itself, when its box meets `lo..hi`.
+    fn features(&self, lo: &Vec3, hi: &Vec3, sink: &mut dyn FnMut(Feature)) {
+        let f = Feature::Ball {
+            center: self.center,
+            radius: self.radius,
+        };
+        let (a, b) = f.bounds();
+        if (0..3).all(|k| a[k] <= hi[k] && lo[k] <= b[k]) {
+            sink(f);
+        }
+    }
+
+    fn has_features(&self) -> bool {
+        true
     }
 
     /// Whether the box, grown by `margin` (and a little for rounding), meets the ball's
@@ -130,5 +157,21 @@ mod tests {
             }
         }
         assert!(!BALL.may_touch(&Vec3::new(2.0, 1.0, -0.5), &Vec3::new(3.0, 1.0, -0.5), 0.1));
+    }
+
+    #[test]
+    fn a_chord_through_the_ball_meets_it_and_one_beside_it_does_not() {
+        let c = BALL.center;
+        let across = (c + Vec3::new(-0.3, 0.1, 0.0), c + Vec3::new(0.3, 0.1, 0.0));
+        assert!(BALL.segment_meets(&across.0, &across.1));
+        let beside = (
+            c + Vec3::new(-0.3, 0.26, 0.0),
+            c + Vec3::new(0.3, 0.26, 0.0),
+        );
+        assert!(!BALL.segment_meets(&beside.0, &beside.1));
+        // Short of the ball, pointing at it.
+        let short = (c + Vec3::new(-0.6, 0.0, 0.0), c + Vec3::new(-0.3, 0.0, 0.0));
+        assert!(!BALL.segment_meets(&short.0, &short.1));
+        assert!(BALL.segment_meets(&c, &c));
     }
 }

@@ -42,6 +42,46 @@ impl fmt::Display for Num {
     }
 }
 
+/// An `f64` to four significant digits for messages, where the last bits are noise to a
+/// reader (`2.3` for `2.3000000000000003`): plain from 1e-4 up to 1e9, scientific outside,
+/// trailing zeros dropped. Not for values that must read back exactly: [`Num`] is.
+///
+/// ```
+/// use hooke_core::Approx;
+/// assert_eq!(Approx(2.3000000000000003).to_string(), "2.3");
+/// assert_eq!(Approx(0.041666666666666685).to_string(), "0.04167");
+/// assert_eq!(Approx(99999.29856).to_string(), "99999");
+/// assert_eq!(Approx(2.7755575615628914e-17).to_string(), "2.776e-17");
+/// assert_eq!(Approx(-1.5e12).to_string(), "-1.5e12");
+/// assert_eq!(Approx(0.0).to_string(), "0");
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Approx(pub f64);
+
+impl fmt::Display for Approx {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        if !x.is_finite() || x == 0.0 {
+            return write!(f, "{x}");
+        }
+        let trim = |t: String| -> String {
+            if t.contains('.') {
+                t.trim_end_matches('0').trim_end_matches('.').to_string()
+            } else {
+                t
+            }
+        };
+        if (1e-4..1e9).contains(&x.abs()) {
+            // Four significant digits: decimals after the point from the magnitude.
+            let digits = (3 - x.abs().log10().floor() as i32).max(0) as usize;
+            return f.write_str(&trim(format!("{x:.digits$}")));
+        }
+        let text = format!("{x:.3e}");
+        let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+        write!(f, "{}e{exponent}", trim(mantissa.to_string()))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -27,6 +27,15 @@ pub enum Feature {
     Segment([Vec3; 2]),
     /// A circular edge (the analytic cylinder's rims).
     Circle(Circle),
+    /// A smooth ball's surface, seen from a triangle as its point nearest the triangle: a
+    /// cloth triangle whose corners keep their distance from a ball can still dip into it
+    /// between them when its edges are long against the radius (deeper than `l²/(8R)`).
+    Ball {
+        /// Centre, metres.
+        center: Vec3,
+        /// Radius, metres.
+        radius: f64,
+    },
 }
 
 impl Feature {
@@ -38,6 +47,9 @@ impl Feature {
                 // Per axis, a circle extends r·√(1 - axis²) from its centre.
                 let e = c.axis.map(|a| c.radius * (1.0 - a * a).max(0.0).sqrt());
                 (c.center - e, c.center + e)
+            }
+            Self::Ball { center, radius } => {
+                (center.add_scalar(-radius), center.add_scalar(*radius))
             }
         }
     }
@@ -97,6 +109,19 @@ pub trait Collider: Debug + Send + Sync {
     fn crossing(&self, from: &Vec3, to: &Vec3) -> Option<Contact> {
         let _ = (from, to);
         None
+    }
+
+    /// Whether the straight segment `a → b` (a spring, a cloth edge) meets the solid: an end
+    /// inside it, or its inside (or a thin or open surface) between the ends. This is what
+    /// "a surface passes through a collider" means for the start's push-out and the
+    /// crossing watch (docs/physics.md §3.4, §3.5). The default asks the ends and the
+    /// crossing test both ways, which is exact for shapes whose free side is convex (planes,
+    /// the box interior) and for meshes; round solids answer exactly themselves.
+    fn segment_meets(&self, a: &Vec3, b: &Vec3) -> bool {
+        self.inside(a)
+            || self.inside(b)
+            || self.crossing(a, b).is_some()
+            || self.crossing(b, a).is_some()
     }
 
     /// Whether the solid is exactly a half-space: every point on the free side of its

@@ -145,6 +145,10 @@ impl Collider for Moving {
                     axis: self.now.rotation * c.axis,
                     radius: c.radius,
                 }),
+                Feature::Ball { center, radius } => Feature::Ball {
+                    center: self.world(&center),
+                    radius,
+                },
             })
         });
     }
@@ -162,6 +166,10 @@ impl Collider for Moving {
 
     fn thickness(&self) -> Option<f64> {
         self.shape.thickness()
+    }
+
+    fn segment_meets(&self, a: &Vec3, b: &Vec3) -> bool {
+        self.shape.segment_meets(&self.local(a), &self.local(b))
     }
 
     fn advance_to(&mut self, t0: f64, t1: f64) {

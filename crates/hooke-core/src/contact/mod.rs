@@ -41,7 +41,9 @@ use crate::collider::response::{Response, coulomb_cut};
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
 use grid::Grid;
-use proximity::{circle_triangle, point_triangle, segment_segment, segment_triangle};
+use proximity::{
+    ball_triangle, circle_triangle, point_triangle, segment_segment, segment_triangle,
+};
 use rayon::prelude::*;
 use respond::{FaceSkip, respond_all, respond_one};
 use std::time::Instant;
@@ -838,6 +840,7 @@ fn feature_gap(
         }
         Feature::Circle(circle) if circle.distance_bound(a, b, c) >= within => return None,
         Feature::Circle(circle) => circle_triangle(circle, a, b, c),
+        Feature::Ball { center, radius } => ball_triangle(center, *radius, a, b, c),
     };
     let gap = a * w[0] + b * w[1] + c * w[2] - anchor;
     (gap.norm_squared() < within * within).then_some((anchor, w))

@@ -327,6 +327,46 @@ pub(crate) fn circle_triangle(circle: &Circle, a: &Vec3, b: &Vec3, c: &Vec3) -> 
     (x, w)
 }
 
+/// The point of collider feature `f` nearest triangle `abc`, and the triangle's weights of
+/// its point nearest to it.
+pub(crate) fn feature_triangle(
+    f: &crate::collider::Feature,
+    a: &Vec3,
+    b: &Vec3,
+    c: &Vec3,
+) -> (Vec3, [f64; 3]) {
+    match f {
+        crate::collider::Feature::Segment([p, q]) => {
+            let (s, w) = segment_triangle(p, q, a, b, c);
+            (p + (q - p) * s, w)
+        }
+        crate::collider::Feature::Circle(circle) => circle_triangle(circle, a, b, c),
+        crate::collider::Feature::Ball { center, radius } => {
+            ball_triangle(center, *radius, a, b, c)
+        }
+    }
+}
+
+/// The closest points of the sphere of `radius` about `center` and triangle `abc`: the
+/// point on the sphere and the barycentric weights of the triangle's point (the
+/// triangle's point nearest the centre; the sphere's point on the ray to it, or along the
+/// triangle's normal when the centre lies on the triangle).
+pub(crate) fn ball_triangle(
+    center: &Vec3,
+    radius: f64,
+    a: &Vec3,
+    b: &Vec3,
+    c: &Vec3,
+) -> (Vec3, [f64; 3]) {
+    let w = point_triangle(center, a, b, c);
+    let q = a * w[0] + b * w[1] + c * w[2];
+    let out = (q - center)
+        .try_normalize(0.0)
+        .or_else(|| (b - a).cross(&(c - a)).try_normalize(0.0))
+        .unwrap_or_else(Vec3::y);
+    (center + out * radius, w)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -6,8 +6,9 @@
 //! are left to it.
 //!
 //! The move is refused when it would leave a spring through the collider (a cloth started
-//! inside a tabletop whose particles would part to its top and its side) or a particle still
-//! inside one: such a start cannot be put right particle by particle, and a run from it
+//! inside a tabletop whose particles would part to its top and its side, or through a ball),
+//! tear or crush a spring (half its length or more: a body swallowed by a large solid), or
+//! leave a particle still inside one: such a start cannot be put right particle by particle, and a run from it
 //! pumps energy into the springs that the contact fights.
 
 use crate::particles::Vec3;
@@ -34,6 +35,16 @@ pub enum StartInside {
          collider, with a gap of at least its contact thickness"
     )]
     Through(usize, usize, usize, String),
+    /// Moved out, a spring would be torn or crushed: the collider holds so much of the body
+    /// (a cloth through a ball, a body that a large solid swallows) that moving each particle
+    /// to its nearest surface point is no shape of the body.
+    #[error(
+        "particles {0} and {1} start inside collider[{2}] ({3}) or nearer it than their \
+         contact thickness, and moved out of it their spring would go from {4} m to {5} m \
+         long: the collider holds too much of the body to move it out particle by particle; \
+         start the body outside the collider, with a gap of at least its contact thickness"
+    )]
+    Deformed(usize, usize, usize, String, crate::Approx, crate::Approx),
     /// A particle is still inside a collider after the move (colliders overlapping there).
     #[error(
         "particle {0} starts inside collider[{1}] ({2}) and cannot be moved out of every \
@@ -55,7 +66,8 @@ impl Simulation {
         let p = &mut self.particles;
         let before = p.x.clone();
         let mut out = Vec::new();
-        let mut moved = vec![false; p.len()];
+        // Per particle: the last collider that moved it.
+        let mut moved = vec![None; p.len()];
         for (k, slot) in model.colliders.iter().enumerate() {
             if slot.response.is_force() {
                 continue;
@@ -73,7 +85,7 @@ impl Simulation {
                     *x += shift;
                     count += 1;
                     deepest = deepest.max(shift.norm());
-                    moved[i] = true;
+                    moved[i] = Some(k);
                 }
             }
             if count > 0 {
@@ -87,7 +99,7 @@ impl Simulation {
         if out.is_empty() {
             return Ok(out);
         }
-        if let Err(e) = through_or_stuck(model, &p.x, &moved) {
+        if let Err(e) = through_or_stuck(model, (&before, &p.x), &moved) {
             p.x = before;
             return Err(e);
         }
@@ -98,28 +110,49 @@ impl Simulation {
     }
 }
 
-/// The first spring of a moved particle that passes through a collider, or moved particle
-/// still inside one.
+/// Share of a spring's length (or its rest length, the longer) by which moving a start out
+/// of a collider may change it: more is a body torn or crushed, not one put beside the
+/// collider.
+const MOST_CHANGE: f64 = 0.5;
+
+/// The first spring of a moved particle that passes through a collider or changes its length
+/// by more than [`MOST_CHANGE`] (`before` → `x`), or moved particle still inside a collider.
 fn through_or_stuck(
     model: &crate::model::Model,
-    x: &[Vec3],
-    moved: &[bool],
+    (before, x): (&[Vec3], &[Vec3]),
+    moved: &[Option<usize>],
 ) -> Result<(), StartInside> {
+    for s in &model.springs {
+        let (i, j) = (s.i as usize, s.j as usize);
+        let Some(k) = moved[i].or(moved[j]) else {
+            continue;
+        };
+        let (was, now) = ((before[i] - before[j]).norm(), (x[i] - x[j]).norm());
+        if (now - was).abs() > MOST_CHANGE * was.max(s.rest) {
+            let name = model.colliders[k].shape.name();
+            return Err(StartInside::Deformed(
+                i,
+                j,
+                k,
+                name,
+                crate::Approx(was),
+                crate::Approx(now),
+            ));
+        }
+    }
     for (k, slot) in model.colliders.iter().enumerate() {
         if slot.response.is_force() {
             continue;
         }
         for s in &model.springs {
             let (i, j) = (s.i as usize, s.j as usize);
-            if (moved[i] || moved[j])
-                && (slot.shape.crossing(&x[i], &x[j]).is_some()
-                    || slot.shape.crossing(&x[j], &x[i]).is_some())
+            if (moved[i].is_some() || moved[j].is_some()) && slot.shape.segment_meets(&x[i], &x[j])
             {
                 return Err(StartInside::Through(i, j, k, slot.shape.name()));
             }
         }
         for (i, x) in x.iter().enumerate() {
-            if moved[i] && slot.shape.inside(x) {
+            if moved[i].is_some() && slot.shape.inside(x) {
                 return Err(StartInside::Stuck(i, k, slot.shape.name()));
             }
         }

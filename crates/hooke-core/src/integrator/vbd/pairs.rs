@@ -1,8 +1,7 @@
 //! Contact pairs between a body's surfaces and a collider's features: which particles
 //! feel them, and their closest points at any positions (docs/physics.md §4.1).
 
-use crate::collider::Feature;
-use crate::contact::proximity::{point_triangle, segment_segment, segment_triangle};
+use crate::contact::proximity::{point_triangle, segment_segment};
 use crate::particles::Vec3;
 
 /// What a pair's two sides are.
@@ -69,18 +68,6 @@ pub(super) fn stencil(pair: &Pair, x: &[Vec3]) -> ([f64; 4], Vec3, usize, bool) 
             let w = point_triangle(&anchor, p(0), p(1), p(2));
             ([w[0], w[1], w[2], 0.0], anchor, 3, true)
         }
-    }
-}
-
-/// The point of feature `f` nearest triangle `abc`, and the triangle's weights of its
-/// point nearest to it.
-pub(super) fn feature_triangle(f: &Feature, a: &Vec3, b: &Vec3, c: &Vec3) -> (Vec3, [f64; 3]) {
-    match f {
-        Feature::Segment([p, q]) => {
-            let (s, w) = segment_triangle(p, q, a, b, c);
-            (p + (q - p) * s, w)
-        }
-        Feature::Circle(circle) => crate::contact::proximity::circle_triangle(circle, a, b, c),
     }
 }
 

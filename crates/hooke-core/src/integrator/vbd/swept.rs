@@ -2,7 +2,7 @@
 //! descent may let the collider jump at once (the swept step, docs/physics.md §4.1).
 
 use super::detect::bounds_of;
-use super::pairs::feature_triangle;
+use crate::contact::proximity::feature_triangle;
 use crate::model::Model;
 use crate::particles::Particles;
 
