@@ -305,3 +305,51 @@ fn skipping_what_cannot_touch_changes_no_bit() {
         );
     }
 }
+
+/// Issue 54: implicit Euler at 1/60 s lets the cloth through the round table (its contacts
+/// come after a step that moves the cloth centimetres). It may not do so in silence: the
+/// crossing watch names the table at the first step after which an exported frame crosses
+/// it, by the signed-volume test, which knows nothing of the solver's.
+#[test]
+fn implicit_at_a_frame_per_step_says_when_the_cloth_first_crosses_the_table() {
+    let overrides = Overrides {
+        integrator: Some(Integrator::Implicit),
+        dt: Some(1.0 / 60.0),
+        every: Some(1),
+        duration: Some(1.0),
+        ..Overrides::default()
+    };
+    let mut scene = builtin("cloth-table", &overrides);
+    let dir = std::env::temp_dir().join(format!("hooke-contact-watch-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut export = ObjExport::new(&dir, &scene).unwrap();
+    export.frame(0, &scene).unwrap();
+    let mut first_crossing = None;
+    let mut first_notice = None;
+    for f in 1..=scene.steps {
+        scene.simulation.step().unwrap();
+        if first_notice.is_none() {
+            first_notice = scene.simulation.take_notices().into_iter().next();
+        }
+        export.frame(f, &scene).unwrap();
+        let (c, _) = crossings(&read_frame(&dir.join(format!("frame-{f:05}.obj"))));
+        if c > 0 && first_crossing.is_none() {
+            first_crossing = Some(f);
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+    let crossed = first_crossing.expect("the cloth crossed the table at 1/60 s");
+    let notice = first_notice.expect("a crossing was said");
+    assert_eq!(notice.step, crossed, "{notice:?}");
+    assert_eq!(notice.collider, 1, "{notice:?}");
+    assert!(
+        matches!(
+            notice.cause,
+            hooke_core::Cause::LargeStep {
+                integrator: Integrator::Implicit,
+                ..
+            }
+        ),
+        "{notice:?}"
+    );
+}

@@ -706,3 +706,31 @@ fn the_readme_is_short_and_its_first_screen_shows_and_tells() {
         .collect();
     assert!(commits.is_empty(), "README.md names commits: {commits:?}");
 }
+
+/// Issue 54: one Rust version everywhere it is named: the workspace's `rust-version`, the
+/// Python package's, `.ci/run`'s message and the README's first command.
+#[test]
+fn the_rust_version_is_the_same_wherever_it_is_named() {
+    let root = workspace();
+    let read = |p: &str| std::fs::read_to_string(root.join(p)).unwrap();
+    let version = |manifest: &str| {
+        manifest
+            .lines()
+            .find_map(|l| l.strip_prefix("rust-version = \""))
+            .and_then(|v| v.strip_suffix('"'))
+            .map(str::to_string)
+            .unwrap()
+    };
+    let workspace_version = version(&read("Cargo.toml"));
+    assert_eq!(version(&read("python/Cargo.toml")), workspace_version);
+    for (file, phrase) in [
+        (".ci/run", format!("({workspace_version} or newer)")),
+        ("README.md", format!("Rust {workspace_version} or newer")),
+        ("docs/python.md", format!("(Rust {workspace_version}+)")),
+    ] {
+        assert!(
+            read(file).contains(&phrase),
+            "{file} does not say {phrase:?}"
+        );
+    }
+}

@@ -147,6 +147,18 @@ impl Inner {
                     Ok::<u64, hooke_core::Divergence>(done)
                 })
             });
+            // What the steps could not keep of the run's promises (a surface through a
+            // collider) is a Python warning, as the command line's is a printed one.
+            for n in self.scene.simulation.take_notices() {
+                let message =
+                    std::ffi::CString::new(driver::describe(&self.scene, &n)).unwrap_or_default();
+                PyErr::warn(
+                    py,
+                    &py.get_type::<pyo3::exceptions::PyRuntimeWarning>(),
+                    &message,
+                    1,
+                )?;
+            }
             left -= done.map_err(|e| error(e.into()))?;
             py.check_signals()?;
         }

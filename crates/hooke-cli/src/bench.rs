@@ -436,7 +436,7 @@ fn cloth(
         println!("{}", serde_json::to_string(&figures)?);
     } else {
         println!(
-            "cloth N={n}{}{}: {springs} springs, {steps} {integrator} steps on {} threads ({} \
+            "cloth N={n}{}{}: {springs} springs, {steps} {integrator} steps on {} ({} \
              kernel, {} batches, runs by {}) in {:.3} s: {:.1} steps/s, {:.1} M spring updates/s; median step {:.3} \
              ms ({:.1} M/s), fastest {:.3} ms; centre y = {:.12}\n  bandwidth: triad {:.1} GB/s, \
              a step moves at least {:.1} MB, so at most {:.1} steps/s; the median step runs at \
@@ -447,7 +447,7 @@ fn cloth(
                 Some((seed, false)) => format!(", shuffled by {seed}"),
                 None => String::new(),
             },
-            figures.threads,
+            threads(figures.threads),
             figures.kernel,
             scene.simulation.workspace().kernel().batches(),
             scene.simulation.workspace().kernel().run_lanes(),
@@ -531,7 +531,7 @@ fn scene_steps(
         println!("{}", serde_json::to_string(&figures)?);
     } else {
         println!(
-            "{}: {} particles, {} springs, {steps} {} steps of {} s on {} threads ({} kernel, \
+            "{}: {} particles, {} springs, {steps} {} steps of {} s on {} ({} kernel, \
              {} batches, runs by {}) in {:.3} s: {:.0} steps/s (median step {:.1} µs, fastest {:.1} µs), {:.3} s per \
              simulated second; contacts {:.0}% of the time ({} candidate rebuilds){}",
             figures.scene,
@@ -539,7 +539,7 @@ fn scene_steps(
             figures.springs,
             figures.integrator,
             figures.dt,
-            figures.threads,
+            threads(figures.threads),
             figures.kernel,
             sim.workspace().kernel().batches(),
             sim.workspace().kernel().run_lanes(),
@@ -658,16 +658,25 @@ fn renders(
             println!("{}", serde_json::to_string(&figures)?);
         } else {
             println!(
-                "{:<12} {:>8} triangles at {width}x{height}, {}x AA, {} threads: render {:.1} ms, \
+                "{:<12} {:>8} triangles at {width}x{height}, {}x AA, {}: render {:.1} ms, \
                  PNG encode {:.1} ms (median of {repeat})",
                 figures.scene,
                 figures.triangles,
                 figures.samples_per_pixel,
-                figures.threads,
+                threads(figures.threads),
                 figures.render_ms,
                 figures.png_encode_ms
             );
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// `1 thread`, `2 threads`.
+fn threads(n: usize) -> String {
+    if n == 1 {
+        "1 thread".to_string()
+    } else {
+        format!("{n} threads")
+    }
 }

@@ -57,9 +57,18 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
         println!("{advice}");
     }
     if sim.integrator() == Integrator::Vbd {
+        for message in crate::risks::volumetric_bodies(&scene) {
+            println!("warning: {message}");
+        }
         println!(
-            "vbd guarantees: no surface crosses a collider or another surface at any dt \
-             (every update is bounded, docs/physics.md §4.1), and stability at any dt"
+            "vbd guarantees: stability at any dt; no surface crosses a still collider or \
+             another surface at any dt (every update is bounded, docs/physics.md §4.1); a \
+             moving collider or keyed pins are followed in parts of the step, down to dt/{}, \
+             and where a pinned or squeezed particle lies in a moving collider's path, where \
+             no integrator can keep the bound, the run warns at the step it happens; a run \
+             whose energy grows by more than a hundredth of its scale beyond the work done on \
+             it stops as diverged",
+            hooke_core::MOST_PARTS
         );
         println!(
             "vbd does not guarantee: a solved step. It stops after {} iterations whether or \
@@ -76,7 +85,9 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
         println!(
             "implicit guarantees: stability at any dt (one linearised Newton step per step, \
              conjugate gradients to 1e-8); not a solved nonlinear step, nor contacts inside \
-             the solve: the contact phase after the step does as for the explicit schemes"
+             the solve: the contact phase after the step does as for the explicit schemes, \
+             so a step that moves a particle farther than the tunnelling limits below can \
+             leave a surface through a collider (the run warns at the first step that does)"
         );
     }
     for t in tunnelling(&scene) {

@@ -89,7 +89,10 @@ enum Command {
 #[derive(Args, Clone, Default)]
 struct SetupArgs {
     /// Integrator: euler, symplectic, midpoint, rk4, implicit or vbd (block descent: one
-    /// crossing-free implicit step per display frame, docs/physics.md §4.1).
+    /// implicit step per display frame that keeps every surface out of still colliders and
+    /// other surfaces; a pinned or squeezed particle in a moving collider's path cannot be,
+    /// and the run warns when one is, docs/physics.md §4.1). `hooke check` says what each
+    /// integrator promises for a scene.
     #[arg(long)]
     integrator: Option<Integrator>,
     /// Step size in seconds.

@@ -76,7 +76,7 @@ pub fn demo(out: &Path, view: &View) -> Result<ExitCode> {
         write_png_named(&path, "--out", &view.pixels(&scene, &camera))?;
         eprintln!(
             "{name:<14} {} s simulated in {:.2} s, still rendered in {:.2} s -> {}",
-            Num(scene.simulation.time()),
+            hooke_core::Approx(scene.simulation.time()),
             simulated.as_secs_f64(),
             (started.elapsed() - simulated).as_secs_f64(),
             path.display()

@@ -219,3 +219,27 @@ pub(crate) fn warn_if_tunnelling(scene: &Scene) {
         eprintln!("warning: {message}");
     }
 }
+
+/// For block descent: the volumetric bodies (lattices), which it does not converge on at a
+/// display frame (a disturbance crosses about one colour of particles per iteration, and a
+/// jelly has no soft mode to give way), and which gain energy on landing even at small
+/// steps; the integrator to use instead, with its stable step.
+pub(crate) fn volumetric_bodies(scene: &Scene) -> Vec<String> {
+    let estimate = scene.simulation.stability();
+    let rk4 = estimate.max_dt(Integrator::Rk4);
+    scene
+        .bodies
+        .iter()
+        .filter(|b| matches!(b.topology, hooke_scene::Topology::Lattice(_)))
+        .map(|b| {
+            format!(
+                "body '{}' is a volumetric lattice, which block descent does not converge on: \
+                 its runs stop when their energy grows (the jello worlds at 1/60 s, the \
+                 jelly cube on landing); use `--integrator rk4 --dt {:.3e}` (its stable \
+                 step's half)",
+                b.name,
+                0.5 * rk4
+            )
+        })
+        .collect()
+}

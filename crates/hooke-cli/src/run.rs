@@ -158,7 +158,7 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         sim.steps(),
         Num(sim.dt()),
         sim.integrator(),
-        Num(sim.time()),
+        hooke_core::Approx(sim.time()),
         sim.particles().len(),
         sim.model().springs.len()
     );

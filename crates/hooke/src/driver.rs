@@ -8,16 +8,76 @@ use hooke_core::Num;
 use hooke_scene::Scene;
 use std::time::{Duration, Instant};
 
-/// Runs shorter than this many steps show no progress bar.
-const PROGRESS_FROM: u64 = 10_000;
-
-/// The progress of `steps` steps of the scene, shown by the installed reporter when the
-/// run is long.
+/// The progress of `steps` steps of the scene, shown by the installed reporter (which
+/// decides when a run is long enough to show).
 fn progress(scene: &Scene, steps: u64) -> Box<dyn Progress> {
-    if steps < PROGRESS_FROM {
+    if steps == 0 {
         return Box::new(Hidden);
     }
     reporter().run(&scene.spec.name, steps)
+}
+
+/// Says, through the installed reporter, the notices of the steps just taken (see
+/// [`hooke_core::Notice`]), with the body and the collider named.
+fn say_notices(scene: &mut Scene) {
+    for n in scene.simulation.take_notices() {
+        reporter().warn(&describe(scene, &n));
+    }
+}
+
+/// Says, at a run's end, how many steps each notice's promise was broken in, when more than
+/// the first.
+fn tally_notices(scene: &Scene) {
+    use hooke_core::Cause;
+    for (n, steps) in scene.simulation.notice_tally() {
+        if *steps > 1 {
+            let why = match n.cause {
+                Cause::LargeStep { integrator, .. } => {
+                    format!("{integrator}'s steps moved it farther than its contacts can follow")
+                }
+                Cause::Pinned => "a pinned particle lay in the collider's path".to_string(),
+                Cause::Squeezed { .. } => {
+                    "the collider squeezed it faster than the parts of a step could follow"
+                        .to_string()
+                }
+            };
+            reporter().warn(&format!(
+                "a surface of body {} ended {steps} steps in all through collider[{}] ({}), \
+                 the first at step {}: {why}",
+                body_of(scene, n.particle),
+                n.collider,
+                scene.simulation.model().colliders[n.collider].shape.name(),
+                n.step
+            ));
+        }
+    }
+}
+
+/// `'name'` of the body holding `particle`.
+fn body_of(scene: &Scene, particle: usize) -> String {
+    scene
+        .bodies
+        .iter()
+        .find(|b| b.range.contains(&particle))
+        .map_or_else(
+            || format!("of particle {particle}"),
+            |b| format!("'{}'", b.name),
+        )
+}
+
+/// One notice as a sentence: when, which body through which collider, and why.
+pub fn describe(scene: &Scene, n: &hooke_core::Notice) -> String {
+    format!(
+        "step {} (t = {} s): a surface of body {} (particle {}) ended the step through \
+         collider[{}] ({}), which the run promised not to let happen: {}",
+        n.step,
+        hooke_core::Approx(n.time),
+        body_of(scene, n.particle),
+        n.particle,
+        n.collider,
+        scene.simulation.model().colliders[n.collider].shape.name(),
+        n.cause
+    )
 }
 
 /// The whole number of the scene's steps nearest to `seconds` of simulated time (what
@@ -77,12 +137,12 @@ pub fn steps_to(scene: &Scene, at: Option<f64>) -> Result<u64> {
 
 /// Steps `n` times, one at a time so that an interrupt is answered within a step.
 fn steps(scene: &mut Scene, n: u64, bar: &dyn Progress) -> Result<()> {
-    for k in 0..n {
+    for _ in 0..n {
         interrupt::check(&scene.simulation)?;
-        scene.simulation.step()?;
-        if k % 1024 == 1023 {
-            bar.set(scene.simulation.steps());
-        }
+        let stepped = scene.simulation.step();
+        say_notices(scene);
+        stepped?;
+        bar.set(scene.simulation.steps());
     }
     Ok(())
 }
@@ -101,6 +161,7 @@ pub fn drive(scene: &mut Scene, mut on_frame: impl FnMut(u64, &Scene) -> Result<
     // Steps past the last full frame are still run: the run's length is what was asked for.
     steps(scene, total % every, bar.as_ref())?;
     bar.finish();
+    tally_notices(scene);
     Ok(())
 }
 
@@ -109,6 +170,7 @@ pub fn advance(scene: &mut Scene, n: u64) -> Result<()> {
     let bar = progress(scene, n);
     steps(scene, n, bar.as_ref())?;
     bar.finish();
+    tally_notices(scene);
     Ok(())
 }
 
@@ -127,11 +189,12 @@ pub fn advance(scene: &mut Scene, n: u64) -> Result<()> {
 /// assert!((left - 0.5 * dt).abs() < 1e-12);
 /// ```
 pub fn catch_up(scene: &mut Scene, mut owed: f64, budget: Duration) -> Result<f64> {
-    let sim = &mut scene.simulation;
-    let (dt, started) = (sim.dt(), Instant::now());
+    let (dt, started) = (scene.simulation.dt(), Instant::now());
     while owed >= dt {
-        interrupt::check(sim)?;
-        sim.step()?;
+        interrupt::check(&scene.simulation)?;
+        let stepped = scene.simulation.step();
+        say_notices(scene);
+        stepped?;
         owed -= dt;
         if started.elapsed() > budget {
             return Ok(0.0);

@@ -11,6 +11,12 @@ pub trait Reporter: Send + Sync {
     fn run(&self, scene: &str, steps: u64) -> Box<dyn Progress>;
     /// A build that takes a while begins; `what` says what is built and how large it is.
     fn build(&self, what: &str) -> Box<dyn Progress>;
+    /// A run found something it promised not to do (a surface through a collider, a
+    /// warning from the library's [`hooke_core::Notice`]s); `message` says what, where and
+    /// why. The default prints `warning: MESSAGE` on stderr.
+    fn warn(&self, message: &str) {
+        eprintln!("warning: {message}");
+    }
 }
 
 /// One job's progress.

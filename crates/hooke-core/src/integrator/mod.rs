@@ -24,6 +24,13 @@ use std::str::FromStr;
 pub(crate) use blocks::Sym3;
 pub(crate) use vbd::swept::collider_gap;
 
+/// The range of step sizes a scene may take, seconds. Every integrator divides by `dt²`
+/// (block descent's inertia `m/dt²`, implicit Euler's `M/dt`, the stable-step estimates),
+/// and the contact and stability figures multiply by it: outside this range those numbers
+/// leave what doubles hold with room to spare, and no scene means such a step (a
+/// femtosecond, or a step of over a quarter of an hour).
+pub const DT_RANGE: std::ops::RangeInclusive<f64> = 1e-15..=1e3;
+
 /// The integration scheme; maps 1:1 to the `--integrator` flag and the scene files' names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Integrator {
@@ -77,6 +84,14 @@ impl Integrator {
             Self::Implicit => Some(implicit::CG_MAX_ITERATIONS),
             _ => None,
         }
+    }
+
+    /// Whether a step takes energy out and nothing after it puts any back: implicit Euler
+    /// solved with its contacts inside the solve (block descent), so no contact phase moves
+    /// a particle out of a collider after the step. Such a run may not gain more than a
+    /// hundredth of its energy scale beyond the work done on it (docs/physics.md §7).
+    pub fn dissipates(self) -> bool {
+        matches!(self, Self::Vbd)
     }
 
     /// Order of convergence on smooth problems.

@@ -5,12 +5,14 @@
 //! unless contacts moved particles after it.
 
 pub(crate) mod divergence;
+pub(crate) mod notice;
 pub(crate) mod renumber;
 pub(crate) mod runaway;
 pub(crate) mod stability;
 pub(crate) mod start;
 pub(crate) mod summary;
-mod swept;
+pub(crate) mod swept;
+mod watch;
 
 use crate::assembly::kernel::Kernel;
 use crate::contact::{self, ContactState, ContactStats};
@@ -20,9 +22,11 @@ use crate::model::{Attachment, Model};
 use crate::parallel;
 use crate::particles::{Particles, Vec3};
 use divergence::{Divergence, StepEnd};
+use notice::{Cause, Notice, Notices};
 use renumber::Renumbering;
 use runaway::EnergyWatch;
 use stability::StabilityEstimate;
+use watch::CrossingWatch;
 
 /// A mass-spring system being simulated.
 ///
@@ -57,6 +61,9 @@ pub struct Simulation {
     /// The state the run started from, for the stable-step estimate a divergence names
     /// (the one `hooke check` gives).
     initial: Particles,
+    /// The crossing watch ([`watch`]) and what it found.
+    crossings: CrossingWatch,
+    notices: Notices,
 }
 
 /// Why [`Simulation::renumber`] refused a renumbering.
@@ -110,6 +117,8 @@ impl Simulation {
                 verdict: None,
             },
             inline,
+            crossings: CrossingWatch::default(),
+            notices: Notices::default(),
         }
     }
 
@@ -260,7 +269,9 @@ impl Simulation {
     /// [`Simulation::step`] on the current thread.
     fn step_here(&mut self) -> Result<(), Divergence> {
         let time = self.time();
-        let report = if self.integrator == Integrator::Vbd && self.model.has_moving_colliders() {
+        let report = if self.integrator == Integrator::Vbd
+            && (self.model.has_moving_colliders() || !self.model.pin_motions.is_empty())
+        {
             self.step_swept(time)
         } else {
             for slot in &mut self.model.colliders {
@@ -288,6 +299,7 @@ impl Simulation {
             );
         self.step += 1;
         self.end_pins(time + self.dt);
+        self.watch_crossings(time, report);
         divergence::check(StepEnd {
             model: &self.model,
             particles: &self.particles,
@@ -308,6 +320,77 @@ impl Simulation {
             self.integrator,
             self.dt,
         )
+    }
+
+    /// The crossing watch after a step from `time` (see [`watch`]): a surface found through
+    /// a collider is recorded as a [`Notice`].
+    fn watch_crossings(&mut self, time: f64, report: StepReport) {
+        if !self.crossings.watches(&self.model) {
+            return;
+        }
+        let vbd = self.integrator == Integrator::Vbd;
+        let mut moved = 0.0;
+        if vbd {
+            // Block descent's bounds keep still colliders out at any step.
+            if !self.model.has_moving_colliders() {
+                return;
+            }
+        } else {
+            let Some(start) = self.workspace.start_positions(report) else {
+                return;
+            };
+            moved = self.crossings.largest_move(start, &self.particles.x);
+            let (lo, hi) = summary::bounds(&self.particles.x);
+            let sweep = self
+                .model
+                .colliders
+                .iter()
+                .map(|c| c.shape.sweep((time, time + self.dt), &lo, &hi))
+                .fold(0.0, f64::max);
+            if moved + sweep <= 0.5 * self.crossings.thickness {
+                return;
+            }
+            moved += sweep;
+        }
+        let Some((collider, ids)) = self
+            .crossings
+            .first_crossing(&self.model, &self.particles.x)
+        else {
+            return;
+        };
+        let pinned = ids.iter().find(|&&i| self.particles.is_pinned(i as usize));
+        let cause = if !vbd {
+            Cause::LargeStep {
+                integrator: self.integrator,
+                moved,
+                thickness: self.crossings.thickness,
+            }
+        } else if pinned.is_some() {
+            Cause::Pinned
+        } else {
+            Cause::Squeezed {
+                parts: self.workspace.vbd.step_parts,
+            }
+        };
+        self.notices.record(Notice {
+            step: self.step,
+            time: self.time(),
+            collider,
+            particle: *pinned.unwrap_or(&ids[0]) as usize,
+            cause,
+        });
+    }
+
+    /// The notices of steps since the last call: each the first of its kind for its
+    /// collider (see [`Notice`]). A run shows them as they come.
+    pub fn take_notices(&mut self) -> Vec<Notice> {
+        self.notices.take()
+    }
+
+    /// Each kind of notice's first occurrence and the steps it happened in, for a run's
+    /// closing word.
+    pub fn notice_tally(&self) -> &[(Notice, u64)] {
+        self.notices.tally()
     }
 
     /// Keyframed pins at the step's start (docs/physics.md §1.2): each where its keys put it

@@ -82,15 +82,31 @@ impl Pending {
     }
 
     /// Writes every file into `dir`: the marker first (so that a folder holding any of the
-    /// report's files is known for a report's), the page last.
+    /// report's files is known for a report's), the page last. When a write fails (a full
+    /// disk) in a folder that held no earlier report, what this commit wrote is removed
+    /// again, the marker last: a failed new report leaves no half of itself.
     pub(crate) fn commit(self, dir: &Path, scenes: &[&str]) -> Result<()> {
         let allowed = names(scenes);
-        write_named(&dir.join(MARKER), FLAG, MARKER_TEXT.as_bytes())?;
-        for (name, bytes) in &self.in_order() {
-            debug_assert!(allowed.contains(name), "{name} was not checked beforehand");
+        let fresh = !is_report(dir);
+        let mut written: Vec<String> = Vec::new();
+        let mut write = |name: &str, bytes: &[u8]| {
             write_named(&dir.join(name), FLAG, bytes)?;
+            written.push(name.to_string());
+            Ok::<(), crate::Error>(())
+        };
+        let result = write(MARKER, MARKER_TEXT.as_bytes()).and_then(|()| {
+            for (name, bytes) in &self.in_order() {
+                debug_assert!(allowed.contains(name), "{name} was not checked beforehand");
+                write(name, bytes)?;
+            }
+            Ok(())
+        });
+        if result.is_err() && fresh {
+            for name in written.iter().rev() {
+                let _ = std::fs::remove_file(dir.join(name));
+            }
         }
-        Ok(())
+        result
     }
 }
 
@@ -218,6 +234,26 @@ mod tests {
         p.commit(&dir, &["chain"]).unwrap();
         assert!(is_report(&dir));
         assert_eq!(std::fs::read_to_string(dir.join(PAGE)).unwrap(), "page");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Issue 54: a new report whose last write fails (here the page's name is taken by a
+    /// folder; on a full disk, any write) leaves no marker or picture behind.
+    #[test]
+    fn a_failed_new_report_takes_back_what_it_wrote() {
+        let dir = fresh("failed");
+        std::fs::create_dir(dir.join(PAGE)).unwrap();
+        let mut p = Pending::default();
+        p.add(PAGE, "page");
+        p.add(JSON, "{}");
+        p.add(scene_file("chain", "still"), "png");
+        assert!(p.commit(&dir, &["chain"]).is_err());
+        let mut left: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(left, [PAGE], "left behind: {left:?}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -75,12 +75,7 @@ pub fn write(dir: &Path, options: &Options) -> Result<Outcome> {
     let references = references::References::find(&checked)?;
     crate::output::check_output_folder(dir, "report")?;
     folder::check(dir, &checked)?;
-    std::fs::create_dir_all(dir).map_err(|e| {
-        crate::Error::from(e).context(format!(
-            "report {}: cannot create the folder",
-            dir.display()
-        ))
-    })?;
+    crate::output::create_folder(dir, "report")?;
     let _held = crate::output::lock::FolderLock::take(dir, "report")?;
     // Again under the lock: another run may have written the folder meanwhile.
     folder::check(dir, &checked)?;

@@ -352,11 +352,15 @@ fn machine(h: &mut String, r: &Report) -> Result<()> {
     let s = &r.speed;
     writeln!(
         h,
-        "</table></div><p>Speed on this machine ({} threads): {} at {:.1} steps/s, {:.3e} spring \
+        "</table></div><p>Speed on this machine ({}): {} at {:.1} steps/s, {:.3e} spring \
          updates/s; the built-in <code>cloth-table</code> takes {:.2} s of wall time per simulated \
          second. <span class=muted>For the full benchmark, <code>hooke bench</code>; figures from \
          other machines are in <code>benches/README.md</code>.</span></p>",
-        s.threads,
+        if s.threads == 1 {
+            "1 thread".to_string()
+        } else {
+            format!("{} threads", s.threads)
+        },
         esc(&s.workload),
         s.steps_per_second,
         s.spring_updates_per_second,

@@ -18,10 +18,11 @@
 //! step size: the integrator can fail to converge, never cross.
 
 use super::graph::Graph;
-use super::pairs::{Pair, Sides, feature_triangle, stencil_distance};
+use super::pairs::{Pair, Sides, stencil_distance};
 use super::planes::{HalfSpaces, Plane, Touches};
 use crate::collider::response::Response;
 use crate::contact::grid::{Cell, Grid};
+use crate::contact::proximity::feature_triangle;
 use crate::contact::proximity::{point_triangle, segment_segment};
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
@@ -187,6 +188,9 @@ pub(super) struct Detection {
     scratch_allowed: Vec<f64>,
     /// The largest thickness of the active surfaces.
     h_max: f64,
+    /// Per particle: how far a pinned surface particle moves over the step apart from the
+    /// shared translation, `|c - u|` (`c` its keyed displacement); zero for the rest.
+    excess: Vec<f64>,
     /// Per particle: its stiffness scale `m/dt² + Σ ks`.
     pub(super) scale: Vec<f64>,
 }
@@ -378,11 +382,16 @@ impl Detection {
         let collider_reach = (COLLIDER_REACH * h_max).max(4.0 * travel).max(1e-6);
         self.detect_colliders(model, x, collider_reach);
         self.detect_features(model, x, collider_reach, dt);
-        let surface_reach = SURFACE_REACH * h_max;
+        let allowed = self.collider_allowance(model);
+        self.set_shift(p, (x, y), &allowed);
+        // Surfaces are searched far enough that pairs beyond the reach stay apart however
+        // far keyed pins move from the shared translation (see `set_radii`).
+        let pins = self.excess.iter().fold(0.0, |a: f64, &b| a.max(b));
+        let surface_reach = (SURFACE_REACH * h_max).max(4.0 * pins);
         self.detect_surfaces(model, x, surface_reach);
         self.index_pairs(n, p);
         self.mark_touching_bodies(graph);
-        self.set_bounds(model, p, (x, y));
+        self.set_radii(allowed, surface_reach);
     }
 
     /// Per particle: the nearest collider surface (capped at `reach`) and which colliders
@@ -579,8 +588,15 @@ impl Detection {
         for (v, t, d, h, mu) in found {
             let tri = topo.triangles[t as usize].0;
             let felt = d <= FELT * h;
-            self.point_surface[v].see(d, felt);
-            self.triangle_surface[t as usize].see(d, felt);
+            // The pair's distance less what its keyed pins move apart from the shared
+            // translation: the room its free particles share (see `set_radii`).
+            let pins = tri
+                .iter()
+                .map(|&i| self.excess[i as usize])
+                .fold(0.0, f64::max);
+            let r = d - self.excess[v] - pins;
+            self.point_surface[v].see(r, felt);
+            self.triangle_surface[t as usize].see(r, felt);
             if !felt {
                 continue;
             }
@@ -642,8 +658,12 @@ impl Detection {
         });
         for (e, f, d, h, mu) in found {
             let felt = d <= FELT * h;
-            self.edge_surface[e].see(d, felt);
-            self.edge_surface[f].see(d, felt);
+            let ([a, b], _) = topo.edges[e];
+            let ([c, dd], _) = topo.edges[f];
+            let most = |i: u32, j: u32| self.excess[i as usize].max(self.excess[j as usize]);
+            let r = d - most(a, b) - most(c, dd);
+            self.edge_surface[e].see(r, felt);
+            self.edge_surface[f].see(r, felt);
             if !felt {
                 continue;
             }
@@ -689,55 +709,56 @@ impl Detection {
         }
     }
 
-    /// Each particle's ball: the shared translation `u` and the radii (see the module docs).
-    fn set_bounds(&mut self, model: &Model, p: &Particles, (x, y): (&[Vec3], &[Vec3])) {
-        let n = x.len();
+    /// Per particle: how far its collider clearance (its triangles' features included) lets
+    /// it move, `γ_c` of the nearest distance and no nearer than its thickness to the
+    /// unfelt ones.
+    fn collider_allowance(&mut self, model: &Model) -> Vec<f64> {
         let topo = &self.topology;
-        // Nearest collider of each particle, its triangles' features included.
         let mut collider = std::mem::take(&mut self.scratch_collider);
         collider.clear();
         collider.extend_from_slice(&self.point_collider);
-        let mut own = std::mem::take(&mut self.scratch_own);
-        own.clear();
-        own.extend_from_slice(&self.point_surface);
         for (t, (tri, _)) in topo.triangles.iter().enumerate() {
             for &i in tri {
-                let i = i as usize;
-                collider[i].meet(&self.triangle_collider[t]);
-                own[i].meet(&self.triangle_surface[t]);
+                collider[i as usize].meet(&self.triangle_collider[t]);
             }
         }
-        for (e, (edge, _)) in topo.edges.iter().enumerate() {
-            for &i in edge {
-                own[i as usize].meet(&self.edge_surface[e]);
-            }
-        }
-        let h_max = self.h_max;
-        let margin = |i: usize| topo.margin(model, i);
         let mut allowed = std::mem::take(&mut self.scratch_allowed);
         allowed.clear();
-        allowed.extend((0..n).map(|i| collider[i].allows(GAMMA_COLLIDER, margin(i), 1.0)));
-        // The shared translation: the surfaces' mean inertial displacement, unless a
-        // surface particle is pinned (it cannot follow) or it would use more than half of
-        // what a collider allows some surface particle (a cloth on a table whose edges
-        // fall), when it would only eat the bounds of the particles that touch.
+        allowed.extend(
+            (0..collider.len())
+                .map(|i| collider[i].allows(GAMMA_COLLIDER, topo.margin(model, i), 1.0)),
+        );
+        self.scratch_collider = collider;
+        allowed
+    }
+
+    /// The shared translation `u` of the surface particles' balls: the free surface
+    /// particles' mean inertial displacement, unless a surface particle is pinned where it
+    /// is, or it would use more than half of what a collider allows some surface particle (a cloth on a table whose edges fall, when it
+    /// would only eat the bounds of the particles that touch). Then each keyed pin's
+    /// excess: how far it moves over the step apart from `u`.
+    fn set_shift(&mut self, p: &Particles, (x, y): (&[Vec3], &[Vec3]), allowed: &[f64]) {
+        let n = x.len();
+        let topo = &self.topology;
         self.shifted.clear();
         self.shifted
             .extend((0..n).map(|i| topo.surface[i] != u16::MAX));
         let mut sum = Vec3::zeros();
         let mut mass = 0.0;
-        let mut pinned = false;
         let mut room = f64::INFINITY;
+        // A pin that stays where it is cannot follow `u` (nor is there room for it to move
+        // apart from `u` near it): then no shift.
+        let mut still = false;
         for i in (0..n).filter(|&i| self.shifted[i]) {
             if p.is_pinned(i) {
-                pinned = true;
+                still |= y[i] == x[i];
             } else {
                 sum += (y[i] - x[i]) * p.mass[i];
                 mass += p.mass[i];
                 room = room.min(allowed[i]);
             }
         }
-        let mut u = if pinned || mass == 0.0 {
+        let mut u = if still || mass == 0.0 {
             Vec3::zeros()
         } else {
             sum / mass
@@ -763,19 +784,56 @@ impl Detection {
             u = Vec3::zeros();
         }
         self.shift = u;
-        let shift = u.norm();
+        // A pin moves by its keys (its target less where it is; zero when still), exactly:
+        // what it moves apart from `u` is room its surface pairs' free sides cannot use.
+        self.excess.clear();
+        self.excess.extend((0..n).map(|i| {
+            if self.shifted[i] && p.is_pinned(i) {
+                (y[i] - x[i] - u).norm()
+            } else {
+                0.0
+            }
+        }));
+    }
+
+    /// Each particle's ball radius (see the module docs): its collider allowance, less the
+    /// shared translation for surface particles, and for those also `γ_s` of the room its
+    /// nearest surface pair leaves (the pair's distance less its pins' excess), no nearer
+    /// than the thickness to the unfelt ones; pairs beyond `reach` are counted at the
+    /// reach less twice the largest excess, which the reach was chosen to exceed.
+    fn set_radii(&mut self, allowed: Vec<f64>, reach: f64) {
+        let n = allowed.len();
+        let topo = &self.topology;
+        let mut own = std::mem::take(&mut self.scratch_own);
+        own.clear();
+        own.extend_from_slice(&self.point_surface);
+        for (t, (tri, _)) in topo.triangles.iter().enumerate() {
+            for &i in tri {
+                own[i as usize].meet(&self.triangle_surface[t]);
+            }
+        }
+        for (e, (edge, _)) in topo.edges.iter().enumerate() {
+            for &i in edge {
+                own[i as usize].meet(&self.edge_surface[e]);
+            }
+        }
+        let pins = self.excess.iter().fold(0.0, |a: f64, &b| a.max(b));
+        let unseen = Clearance::new(reach - 2.0 * pins);
+        let h_max = self.h_max;
+        let shift = self.shift.norm();
         self.bound.clear();
         self.bound.extend((0..n).map(|i| {
             let mut b = allowed[i];
             if self.shifted[i] {
                 b -= shift;
                 if topo.self_pairs {
-                    b = b.min(own[i].allows(GAMMA_SURFACE, h_max, 2.0));
+                    let mut pairs = own[i];
+                    pairs.meet(&unseen);
+                    b = b.min(pairs.allows(GAMMA_SURFACE, h_max, 2.0));
                 }
             }
             b.max(0.0)
         }));
-        self.scratch_collider = collider;
         self.scratch_own = own;
         self.scratch_allowed = allowed;
     }

@@ -75,6 +75,8 @@ pub(crate) struct VbdBuffers {
     /// Iterations and detections of the last step.
     pub(crate) iterations: usize,
     pub(crate) detections: usize,
+    /// Parts the last step was taken in (more than one only with a moving collider).
+    pub(crate) step_parts: u32,
     /// Whether the last step ended at [`MAX_ITERATIONS`] without meeting its stopping rule.
     pub(crate) capped: bool,
     /// The last step's residual: the largest force left on a free particle at the end of
@@ -113,15 +115,24 @@ pub(super) fn step(
     b.momentum.clear();
     for i in 0..n {
         let f = external(i);
+        b.momentum.push(p.v[i] * p.mass[i] + f * dt);
         b.target.push(if p.is_pinned(i) {
-            p.x[i]
+            p.x[i] + p.v[i] * dt
         } else {
             p.x[i] + p.v[i] * dt + f * (dt * dt / p.mass[i])
         });
-        b.momentum.push(p.v[i] * p.mass[i] + f * dt);
     }
     b.detection
         .detect(model, p, &b.graph, (&p.x, &b.target), dt);
+    // A keyframed pin moves at its velocity over the step (docs/physics.md §1.2): implicit
+    // Euler solves the free particles against where it ends, so its springs pull them along
+    // within the step, and it keeps that velocity (a still pin's target is where it is).
+    // The detection, at the step's start, counted that move in the bounds.
+    for ((x, target), inv_mass) in p.x.iter_mut().zip(&b.target).zip(&p.inv_mass) {
+        if *inv_mass == 0.0 {
+            *x = *target;
+        }
+    }
     b.detected.clear();
     b.detected.extend_from_slice(&p.x);
     b.detections = 1;
@@ -255,6 +266,7 @@ pub(super) fn step(
         }
     }
     b.iterations = iterations;
+    b.step_parts = 1;
     b.capped = !converged;
     b.residual = residual(
         &Local {
@@ -269,8 +281,10 @@ pub(super) fn step(
         p,
         g,
     );
-    for ((v, x), s) in p.v.iter_mut().zip(&p.x).zip(start) {
-        *v = (x - s) / dt;
+    for (i, (v, (x, s))) in p.v.iter_mut().zip(p.x.iter().zip(start)).enumerate() {
+        if p.inv_mass[i] != 0.0 {
+            *v = (x - s) / dt;
+        }
     }
     keep_momentum(model, p, start, &b.momentum, dt);
     StepReport::SAVED
@@ -358,7 +372,7 @@ fn residual(local: &Local<'_>, p: &Particles, g: f64) -> f64 {
 fn keep_momentum(model: &Model, p: &mut Particles, start: &[Vec3], momentum: &[Vec3], dt: f64) {
     let closed = model.colliders.is_empty()
         && model.attachments.is_empty()
-        && model.drag == 0.0
+        && !model.has_drag()
         && (0..p.len()).all(|i| !p.is_pinned(i));
     if !closed {
         return;

@@ -1,0 +1,156 @@
+//! What a step could not keep of the project's promises, said at the step where it happened
+//! (docs/physics.md §3.5): a surface that ended a step through a collider. The simulation
+//! keeps the first notice of each kind for each collider and counts the steps of the rest,
+//! so a long run says it once, when it begins, and how often at its end.
+
+use crate::integrator::Integrator;
+use crate::number::Approx;
+use std::fmt;
+
+/// A surface (a cloth's edge or triangle) that passes through a collider after a step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Notice {
+    /// The step after which it was found (1 for the first step).
+    pub step: u64,
+    /// The simulated time then, seconds.
+    pub time: f64,
+    /// The collider's index in the model.
+    pub collider: usize,
+    /// A particle of the edge or triangle that meets it.
+    pub particle: usize,
+    /// Why the integrator could not keep it out.
+    pub cause: Cause,
+}
+
+/// Why a step left a surface through a collider.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Cause {
+    /// The integrator's contacts come after its step (every integrator but block descent),
+    /// and the step moved a particle `moved` metres relative to the collider, more than half
+    /// the thinnest contact thickness `thickness`: a surface can pass a collider's edge, or
+    /// a thin part of it, between two looks.
+    LargeStep {
+        /// The integrator that took the step.
+        integrator: Integrator,
+        /// The step's largest move of a surface particle, metres.
+        moved: f64,
+        /// The thinnest contact thickness of the surfaces, metres.
+        thickness: f64,
+    },
+    /// Block descent with a moving collider: a pinned particle lies in the collider's path,
+    /// where nothing can move it aside.
+    Pinned,
+    /// Block descent with a moving collider: the collider closed on a particle squeezed
+    /// between it and something else faster than `parts` parts of the step could follow
+    /// (docs/physics.md §4.1, "A moving collider").
+    Squeezed {
+        /// The parts the step was taken in.
+        parts: u32,
+    },
+}
+
+impl Cause {
+    /// Two notices of one kind for one collider are said once.
+    pub(crate) fn kind(&self) -> u8 {
+        match self {
+            Self::LargeStep { .. } => 0,
+            Self::Pinned => 1,
+            Self::Squeezed { .. } => 2,
+        }
+    }
+}
+
+impl fmt::Display for Cause {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::LargeStep {
+                integrator,
+                moved,
+                thickness,
+            } => write!(
+                f,
+                "{integrator} resolves contacts after its step, and this step moved a particle \
+                 {} mm, more than half the contact thickness of {} mm, so a surface can pass a \
+                 collider's edge or a thin part of it between two looks; take a smaller dt \
+                 (hooke check says which), or `--integrator vbd`, whose steps keep every \
+                 surface out at any dt",
+                Approx(moved * 1e3),
+                Approx(thickness * 1e3),
+            ),
+            Self::Pinned => f.write_str(
+                "a pinned particle lies in the moving collider's path and nothing can move it \
+                 aside, so no integrator can keep the surface out there; key the collider or \
+                 the pins around each other",
+            ),
+            Self::Squeezed { parts } => write!(
+                f,
+                "the moving collider squeezed a particle against something that held it, \
+                 faster than block descent's {parts} parts of the step could follow (each part \
+                 lets the collider close at most half the gap, down to a part of dt/{}); give \
+                 the body room to move aside, or key the collider slower",
+                crate::simulation::swept::MOST_PARTS
+            ),
+        }
+    }
+}
+
+/// The notices of a run: the new ones not yet taken, and per (collider, kind) the first
+/// notice and the steps it happened in.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Notices {
+    fresh: Vec<Notice>,
+    tally: Vec<(Notice, u64)>,
+}
+
+impl Notices {
+    /// Records `n`: new when its collider has had none of its kind.
+    pub(crate) fn record(&mut self, n: Notice) {
+        let key = (n.collider, n.cause.kind());
+        if let Some((_, count)) = self
+            .tally
+            .iter_mut()
+            .find(|(first, _)| (first.collider, first.cause.kind()) == key)
+        {
+            *count += 1;
+        } else {
+            self.tally.push((n.clone(), 1));
+            self.fresh.push(n);
+        }
+    }
+
+    /// The notices not yet taken.
+    pub(crate) fn take(&mut self) -> Vec<Notice> {
+        std::mem::take(&mut self.fresh)
+    }
+
+    /// Each kind's first notice and the steps it happened in.
+    pub(crate) fn tally(&self) -> &[(Notice, u64)] {
+        &self.tally
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_kind_is_said_once_per_collider_and_counted() {
+        let at = |step, collider, cause| Notice {
+            step,
+            time: step as f64,
+            collider,
+            particle: 0,
+            cause,
+        };
+        let mut n = Notices::default();
+        n.record(at(3, 1, Cause::Pinned));
+        n.record(at(4, 1, Cause::Pinned));
+        n.record(at(4, 2, Cause::Pinned));
+        n.record(at(5, 1, Cause::Squeezed { parts: 9 }));
+        let fresh = n.take();
+        assert_eq!(fresh.iter().map(|n| n.step).collect::<Vec<_>>(), [3, 4, 5]);
+        assert!(n.take().is_empty());
+        assert_eq!(n.tally()[0].1, 2);
+        assert!(Cause::Squeezed { parts: 9 }.to_string().contains("9 parts"));
+    }
+}
