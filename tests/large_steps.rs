@@ -467,3 +467,44 @@ fn block_descent_stops_rather_than_end_a_stiff_body_wrong() {
     let e = cube.simulation.advance(steps).unwrap_err().to_string();
     assert!(e.contains("the energy grew"), "jello-cube: {e}");
 }
+
+/// Issue 55: block descent ends a step as IPC does: when its last iteration moved no free
+/// particle faster than the tolerance (its move over `dt`), or at its iteration budget, both
+/// from `[simulation]` or the command line. Every step of `cloth-table` landing on its table
+/// either ends within the tolerance or takes its whole budget, and a smaller budget is kept.
+#[test]
+fn block_descent_ends_its_steps_by_a_tolerance_in_metres_per_second_or_a_budget() {
+    for (tolerance, iterations) in [(0.01, 24), (0.05, 3)] {
+        let overrides = Overrides {
+            integrator: Some(Integrator::Vbd),
+            dt: Some(1.0 / 60.0),
+            duration: Some(1.0),
+            tolerance: Some(tolerance),
+            iterations: Some(iterations),
+            ..Overrides::default()
+        };
+        let mut scene = crate::common::builtin("cloth-table", &overrides);
+        let rule = scene.simulation.workspace().stop_rule();
+        assert_eq!(
+            (rule.tolerance, rule.iterations),
+            (tolerance, iterations as usize)
+        );
+        let (mut settled, mut capped) = (0, 0);
+        for _ in 0..scene.steps {
+            scene.simulation.step().unwrap();
+            let w = scene.simulation.workspace();
+            assert!(w.vbd_iterations() <= iterations as usize);
+            if w.capped() {
+                assert_eq!(w.vbd_iterations(), iterations as usize);
+                capped += 1;
+            } else {
+                assert!(w.vbd_last_speed() <= tolerance, "{}", w.vbd_last_speed());
+                settled += 1;
+            }
+        }
+        assert!(
+            settled > 0,
+            "tolerance {tolerance}: no step settled ({capped} capped)"
+        );
+    }
+}

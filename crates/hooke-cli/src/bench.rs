@@ -78,6 +78,15 @@ pub enum Bench {
         /// Worker threads (default: one per core).
         #[arg(long)]
         threads: Option<usize>,
+        /// Block descent: the stopping tolerance, m/s (default: the scene's, or 0.01).
+        #[arg(long)]
+        tolerance: Option<f64>,
+        /// Block descent: the iteration budget per step (default: the scene's, or 24).
+        #[arg(long)]
+        iterations: Option<u64>,
+        /// Also measure each block-descent step's residual (a sweep's cost more a step).
+        #[arg(long)]
+        residual: bool,
         /// Print one JSON object instead of text.
         #[arg(long)]
         json: bool,
@@ -234,8 +243,19 @@ struct SceneFigures {
     /// Steps that ended at an iteration cap without meeting the solver's stopping rule.
     capped_steps: u64,
     /// The largest residual a block-descent step ended with: the force left on a free
-    /// particle over its weight (docs/physics.md §4.1; 0 for the other integrators).
-    max_residual: f64,
+    /// particle over its weight (docs/physics.md §4.1; measured with `--residual`, else
+    /// null).
+    max_residual: Option<f64>,
+    /// Block descent: the steps' final update over the step (the stopping rule's measure,
+    /// m/s), median and largest; its stopping rule; parts per step (more than one with a
+    /// moving collider or keyed pins).
+    median_final_speed: f64,
+    largest_final_speed: f64,
+    tolerance: f64,
+    iteration_budget: usize,
+    parts_per_step: f64,
+    /// Block descent: where the wall time went, seconds; they sum to `seconds`.
+    time_split: Option<TimeSplit>,
     /// Whether the steps were timed from the scene's start (large-step integrators) or
     /// after a warm-up of 100 steps.
     from_start: bool,
@@ -257,6 +277,17 @@ struct SceneFigures {
     contact_share: f64,
     /// Rebuilds of the contact candidate lists during the measured steps.
     contact_rebuilds: u64,
+}
+
+/// Block descent's wall time by what it did, seconds.
+#[derive(Serialize)]
+struct TimeSplit {
+    detection: f64,
+    sweeps: f64,
+    coarse_correction: f64,
+    acceleration: f64,
+    /// Everything else: the steps' set-up and end, the divergence and energy checks.
+    rest: f64,
 }
 
 #[derive(Serialize)]
@@ -328,15 +359,21 @@ pub fn run(bench: &Bench) -> Result<ExitCode> {
             table,
             kernel,
             threads,
+            tolerance,
+            iterations,
+            residual,
             json,
         } => {
             let overrides = Overrides {
                 integrator: *integrator,
                 dt: *dt,
                 table: table.as_deref().map(source::table).transpose()?,
+                tolerance: *tolerance,
+                iterations: *iterations,
                 ..Overrides::default()
             };
-            pool(*threads)?.install(|| scene_steps(scene, &overrides, *kernel, *steps, *json))
+            pool(*threads)?
+                .install(|| scene_steps(scene, &overrides, *kernel, (*steps, *residual), *json))
         }
         Bench::Render {
             targets,
@@ -471,7 +508,7 @@ fn scene_steps(
     name: &str,
     overrides: &Overrides,
     kernel: Option<Kernel>,
-    steps: Option<u64>,
+    (steps, residual): (Option<u64>, bool),
     json: bool,
 ) -> Result<ExitCode> {
     if steps == Some(0) {
@@ -481,6 +518,8 @@ fn scene_steps(
     let whole_run = scene.steps;
     let sim = &mut scene.simulation;
     use_kernel(sim, kernel)?;
+    sim.measure_residuals(residual);
+    let times_before = sim.workspace().solve_times();
     let from_start = matches!(sim.integrator(), Integrator::Implicit | Integrator::Vbd);
     let steps = match steps {
         Some(n) => n,
@@ -493,6 +532,7 @@ fn scene_steps(
     let mut cg_iterations = 0;
     let (mut vbd_iterations, mut vbd_detections) = (0, 0);
     let (mut capped_steps, mut max_residual) = (0, 0.0f64);
+    let (mut final_speeds, mut parts) = (Vec::new(), 0u64);
     let contacts_before = sim.contact_stats();
     let (times, seconds) = StepTimes::run(sim, steps, |sim| {
         let w = sim.workspace();
@@ -501,15 +541,49 @@ fn scene_steps(
         vbd_detections += w.vbd_detections();
         capped_steps += u64::from(w.capped());
         max_residual = max_residual.max(w.vbd_residual());
+        final_speeds.push(w.vbd_last_speed());
+        parts += u64::from(w.vbd_parts());
     })?;
     let contacts = sim.contact_stats();
+    let vbd = sim.integrator() == Integrator::Vbd;
+    let split = vbd.then(|| {
+        let now = sim.workspace().solve_times();
+        let part = |a: std::time::Duration, b: std::time::Duration| (a - b).as_secs_f64();
+        let detection = part(now.detection, times_before.detection);
+        let sweeps = part(now.sweeps, times_before.sweeps);
+        let coarse_correction = part(now.coarse, times_before.coarse);
+        let acceleration = part(now.acceleration, times_before.acceleration);
+        TimeSplit {
+            detection,
+            sweeps,
+            coarse_correction,
+            acceleration,
+            rest: seconds - detection - sweeps - coarse_correction - acceleration,
+        }
+    });
+    final_speeds.sort_by(f64::total_cmp);
+    let rule = sim.workspace().stop_rule();
     let figures = SceneFigures {
         cg_iterations_per_step: cg_iterations as f64 / steps as f64,
         vbd_iterations_per_step: vbd_iterations as f64 / steps as f64,
         vbd_detections_per_step: vbd_detections as f64 / steps as f64,
         iterations_per_step: (cg_iterations + vbd_iterations) as f64 / steps as f64,
         capped_steps,
-        max_residual,
+        max_residual: residual.then_some(max_residual),
+        median_final_speed: if vbd {
+            final_speeds[final_speeds.len() / 2]
+        } else {
+            0.0
+        },
+        largest_final_speed: if vbd {
+            final_speeds.last().copied().unwrap_or(0.0)
+        } else {
+            0.0
+        },
+        tolerance: rule.tolerance,
+        iteration_budget: rule.iterations,
+        parts_per_step: parts as f64 / steps as f64,
+        time_split: split,
         from_start,
         wall_per_simulated_s: seconds / (steps as f64 * sim.dt()),
         dt: sim.dt(),
@@ -557,12 +631,31 @@ fn scene_steps(
                 )
             } else if vbd_iterations > 0 {
                 format!(
-                    ", {:.1} block-descent iterations and {:.1} detections per step, {} of \
-                     {steps} steps capped, largest residual {:.3e} of a weight{}",
+                    ", {:.1} block-descent iterations and {:.2} detections per step, {} of \
+                     {steps} steps at the budget of {} (tolerance {} m/s), final update median \
+                     {:.2e} and largest {:.2e} m/s{}{}{}",
                     figures.vbd_iterations_per_step,
                     figures.vbd_detections_per_step,
                     figures.capped_steps,
-                    figures.max_residual,
+                    figures.iteration_budget,
+                    figures.tolerance,
+                    figures.median_final_speed,
+                    figures.largest_final_speed,
+                    figures.max_residual.map_or(String::new(), |r| format!(
+                        ", largest residual {r:.3e} of a weight"
+                    )),
+                    figures
+                        .time_split
+                        .as_ref()
+                        .map_or(String::new(), |t| format!(
+                            "; time: detection {:.0}%, sweeps {:.0}%, coarse correction {:.0}%, \
+                         acceleration {:.0}%, rest {:.0}%",
+                            100.0 * t.detection / seconds,
+                            100.0 * t.sweeps / seconds,
+                            100.0 * t.coarse_correction / seconds,
+                            100.0 * t.acceleration / seconds,
+                            100.0 * t.rest / seconds
+                        )),
                     if from_start {
                         " (timed from the start)"
                     } else {

@@ -70,14 +70,16 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
              it stops as diverged",
             hooke_core::MOST_PARTS
         );
+        let rule = sim.workspace().stop_rule();
         println!(
-            "vbd does not guarantee: a solved step. It stops after {} iterations whether or \
-             not it met its stopping rule; `hooke bench scene` counts such capped steps and \
-             the largest residual (force left over weight). Contacts are inelastic (cr has \
-             no effect), and a particle slides along a mesh or cylinder collider at most about \
+            "vbd does not guarantee: a solved step. A step ends when its last iteration moved \
+             no particle faster than {} m/s (--tolerance), or after {} iterations \
+             (--iterations) whether or not it got there; `hooke bench scene` counts the steps \
+             at the budget and the final update's speed. Contacts are inelastic (cr has no \
+             effect), and a particle slides along a mesh or cylinder collider at most about \
              0.9 of its gap per detection (along the ground and planes freely), so fast \
              sliding over a tabletop at large steps is held back",
-            Integrator::Vbd.iteration_cap().unwrap_or_default()
+            rule.tolerance, rule.iterations
         );
         return Ok(ExitCode::SUCCESS);
     }

@@ -109,6 +109,21 @@ struct SetupArgs {
     /// `cylinder` for the analytic one.
     #[arg(long, value_name = "OBJ|cylinder")]
     table: Option<String>,
+    /// Block descent: a step ends when its last iteration moved no particle faster than
+    /// this, m/s (default 0.01).
+    #[arg(long, value_name = "M/S", allow_negative_numbers = true, value_parser = parse_speed)]
+    tolerance: Option<f64>,
+    /// Block descent: the most iterations a step takes (default 24).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    iterations: Option<u64>,
+}
+
+/// A speed in m/s: finite and positive.
+fn parse_speed(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        _ => Err(format!("expected a speed in m/s > 0, found '{s}'")),
+    }
 }
 
 /// A frame cadence: a whole number of steps, at least 1.
@@ -145,6 +160,8 @@ impl SetupArgs {
             duration: self.duration,
             every: None,
             table,
+            tolerance: self.tolerance,
+            iterations: self.iterations,
         })
     }
 }

@@ -150,7 +150,10 @@ const TINY_STEP: f64 = 1.0 / 600.0;
 /// a display frame.
 pub(crate) fn large_step_advice(scene: &Scene, estimate: &StabilityEstimate) -> Option<String> {
     let sim = &scene.simulation;
-    if sim.integrator() == Integrator::Vbd || !scene.bodies.iter().any(|b| b.thickness > 0.0) {
+    if sim.integrator() == Integrator::Vbd
+        || !scene.bodies.iter().any(|b| b.thickness > 0.0)
+        || !volumetric_bodies(scene).is_empty()
+    {
         return None;
     }
     // The stable explicit step, and the step that keeps two layers closing at the fastest
@@ -169,8 +172,12 @@ pub(crate) fn large_step_advice(scene: &Scene, estimate: &StabilityEstimate) -> 
     Some(format!(
         "recommendation: explicit steps here must stay below {limit:.3e} s ({:.0} steps per \
          simulated second); `--integrator vbd --dt 0.016666666666666666` takes one implicit \
-         step per 60 Hz frame with no crossing (docs/physics.md §4.1)",
-        1.0 / limit
+         step per 60 Hz frame with no crossing, with its defaults (a step ends when its last \
+         iteration moves no particle faster than {} m/s, or after {} iterations; \
+         docs/physics.md §4.1)",
+        1.0 / limit,
+        hooke_core::StopRule::VBD.tolerance,
+        hooke_core::StopRule::VBD.iterations
     ))
 }
 

@@ -334,3 +334,57 @@ fn check_says_block_descent_is_not_for_a_jelly() {
     assert!(!String::from_utf8_lossy(&out.stdout).contains("volumetric"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 55: `hooke bench scene --json` says, for block descent, iterations and detections
+/// per step, the final update's speed (median and largest), the steps at the budget, and
+/// where the wall time went, in parts that sum to the whole.
+#[test]
+fn a_block_descent_bench_splits_its_time_into_parts_that_sum_to_the_whole() {
+    let dir = scratch("bench-split");
+    let out = hooke(
+        &[
+            "bench",
+            "scene",
+            "chain",
+            "--integrator",
+            "vbd",
+            "--dt",
+            "0.016666666666666666",
+            "--steps",
+            "20",
+            "--tolerance",
+            "0.02",
+            "--json",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let figures: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in [
+        "vbd_iterations_per_step",
+        "vbd_detections_per_step",
+        "median_final_speed",
+        "largest_final_speed",
+        "capped_steps",
+    ] {
+        assert!(figures[key].is_number(), "{key}: {figures}");
+    }
+    assert_eq!(figures["tolerance"], 0.02);
+    let split = &figures["time_split"];
+    let parts: f64 = [
+        "detection",
+        "sweeps",
+        "coarse_correction",
+        "acceleration",
+        "rest",
+    ]
+    .iter()
+    .map(|k| split[k].as_f64().unwrap())
+    .sum();
+    let seconds = figures["seconds"].as_f64().unwrap();
+    assert!(
+        (parts - seconds).abs() <= 1e-9 * seconds,
+        "{parts} vs {seconds}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -61,7 +61,7 @@ pub use excerpt::excerpt;
 pub use forces::air::{AeroSurface, Air, Gust};
 pub use forces::field::ForceField;
 pub use forces::spring::{Spring, SpringKind};
-pub use integrator::{Integrator, UnknownIntegrator};
+pub use integrator::{Integrator, SolveTimes, StopRule, UnknownIntegrator};
 pub use keyframes::{Key, KeyError, Keyframes};
 pub use model::motion::PinMotion;
 pub use model::surface::{DEFAULT_CLOTH_THICKNESS, DEFAULT_SURFACE_FRICTION, Surface};

@@ -95,6 +95,14 @@ impl SceneSpec {
             self.simulation.integrator.0,
             self.simulation.dt.get(),
         );
+        let sim = &self.simulation;
+        if sim.tolerance.is_some() || sim.iterations.is_some() {
+            let default = hooke_core::StopRule::VBD;
+            simulation.set_stop_rule(hooke_core::StopRule {
+                tolerance: sim.tolerance.map_or(default.tolerance, |t| t.get()),
+                iterations: sim.iterations.map_or(default.iterations, |n| n as usize),
+            });
+        }
         let pushed_out = simulation.push_out_start().map_err(|e| {
             let particle = match &e {
                 StartInside::Through(i, ..)

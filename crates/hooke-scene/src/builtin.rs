@@ -30,6 +30,8 @@ fn sim(integrator: Integrator, dt: f64, duration: f64, every: u64, drag: f64) ->
         gravity: f3([0.0, -9.81, 0.0]),
         drag: NonNegative::of(drag),
         mass_drag: NonNegative::of(0.0),
+        tolerance: None,
+        iterations: None,
         air: None,
     }
 }

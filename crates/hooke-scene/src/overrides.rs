@@ -48,6 +48,10 @@ pub struct Overrides {
     pub every: Option<u64>,
     /// Replace every mesh or cylinder collider.
     pub table: Option<TableOverride>,
+    /// Replace block descent's stopping tolerance (m/s).
+    pub tolerance: Option<f64>,
+    /// Replace block descent's iteration budget per step.
+    pub iterations: Option<u64>,
 }
 
 impl Overrides {
@@ -83,6 +87,13 @@ impl Overrides {
         }
         if let Some(every) = self.every {
             sim.every = every;
+        }
+        if let Some(t) = self.tolerance {
+            sim.tolerance =
+                Some(Positive::try_from(t).map_err(|m| invalid("simulation.tolerance", m))?);
+        }
+        if let Some(n) = self.iterations {
+            sim.iterations = Some(n);
         }
         if let Some(table) = &self.table {
             let mut replaced = false;

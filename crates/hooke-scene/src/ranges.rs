@@ -220,6 +220,18 @@ const WIND: Range = range(
     "the air model is incompressible drag, meaningless at the speed of sound",
 );
 
+/// A stopping tolerance.
+const TOLERANCE: Range = range(
+    1e-12,
+    1e3,
+    false,
+    "a velocity in m/s",
+    "a tolerance beyond 1e3 m/s stops every step at once; below 1e-12 m/s no iteration \
+     reaches it",
+);
+/// The most iterations a step may take.
+const MAX_ITERATIONS: u64 = 100_000;
+
 /// Checks `value` (at `key`) against `r`.
 fn check(key: &str, value: f64, r: Range) -> Result<(), BuildError> {
     let magnitude = if r.signed { value.abs() } else { value };
@@ -267,6 +279,20 @@ fn each<const N: usize>(key: &str, values: &[Finite; N], r: Range) -> Result<(),
 pub(crate) fn check_ranges(spec: &SceneSpec) -> Result<(), BuildError> {
     let sim = &spec.simulation;
     // The run's length is checked in steps (`SceneSpec::total_steps`), which says more.
+    if let Some(t) = sim.tolerance {
+        check("simulation.tolerance", t.get(), TOLERANCE)?;
+    }
+    if let Some(n) = sim.iterations
+        && !(1..=MAX_ITERATIONS).contains(&n)
+    {
+        return Err(invalid(
+            "simulation.iterations",
+            format!(
+                "expected 1 to {MAX_ITERATIONS} iterations a step, found {n}: more is years \
+                 of computing for a run"
+            ),
+        ));
+    }
     each("simulation.gravity", &sim.gravity, ACCELERATION)?;
     check("simulation.drag", sim.drag.get(), DRAG)?;
     check("simulation.mass_drag", sim.mass_drag.get(), MASS_DRAG)?;

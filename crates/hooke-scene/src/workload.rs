@@ -37,6 +37,8 @@ pub fn cloth(n: usize) -> SceneSpec {
             gravity: [Finite::of(0.0), Finite::of(-9.81), Finite::of(0.0)],
             drag: NonNegative::of(0.0),
             mass_drag: NonNegative::of(0.0),
+            tolerance: None,
+            iterations: None,
             air: None,
         },
         bodies: vec![BodySpec {

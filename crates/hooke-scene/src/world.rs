@@ -404,6 +404,8 @@ impl World {
                 gravity: [Finite::of(0.0); 3],
                 drag: NonNegative::of(0.0),
                 mass_drag: NonNegative::of(0.0),
+                tolerance: None,
+                iterations: None,
                 air: None,
             },
             bodies: vec![BodySpec {

@@ -135,6 +135,7 @@ pub fn prepare(mut source: Source, arg: &str, overrides: &Overrides) -> Result<S
                 key: match key.as_str() {
                     "simulation.dt" => "--dt".into(),
                     "simulation.duration" => "--duration".into(),
+                    "simulation.tolerance" => "--tolerance".into(),
                     "table" => "--table".into(),
                     _ => key,
                 },

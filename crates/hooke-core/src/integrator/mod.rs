@@ -31,6 +31,56 @@ pub(crate) use vbd::swept::collider_gap;
 /// femtosecond, or a step of over a quarter of an hour).
 pub const DT_RANGE: std::ops::RangeInclusive<f64> = 1e-15..=1e3;
 
+/// How an iterative large-step integrator (block descent) ends a step: when its last
+/// iteration moved no free particle faster than `tolerance` (its move over the step, m/s:
+/// IPC's rule, in the units users think in), or after `iterations`. A residual is kept as
+/// evidence, never as the rule (docs/physics.md §4.1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StopRule {
+    /// The velocity below which the last update counts as converged, m/s.
+    pub tolerance: f64,
+    /// The iteration budget of a step.
+    pub iterations: usize,
+}
+
+impl StopRule {
+    /// Block descent's defaults (chosen by measurement: benches/README.md).
+    pub const VBD: StopRule = StopRule {
+        tolerance: 1e-2,
+        iterations: 24,
+    };
+}
+
+/// Where a large-step integrator's time went, summed over its steps.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SolveTimes {
+    /// Contact detection, the first guess and recolouring.
+    pub detection: std::time::Duration,
+    /// The colour sweeps (the local solves).
+    pub sweeps: std::time::Duration,
+    /// The coarse correction.
+    pub coarse: std::time::Duration,
+    /// The acceleration (and the copies that keep its iterates).
+    pub acceleration: std::time::Duration,
+}
+
+/// A stopwatch read in laps: each [`Lap::lap`] is the time since the last.
+pub(crate) struct Lap(std::time::Instant);
+
+impl Lap {
+    pub(crate) fn start() -> Self {
+        Self(std::time::Instant::now())
+    }
+
+    /// The time since the last lap (or the start), and a new lap begins.
+    pub(crate) fn lap(&mut self) -> std::time::Duration {
+        let now = std::time::Instant::now();
+        let d = now - self.0;
+        self.0 = now;
+        d
+    }
+}
+
 /// The integration scheme; maps 1:1 to the `--integrator` flag and the scene files' names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Integrator {
@@ -80,7 +130,7 @@ impl Integrator {
     /// implicit step's conjugate gradients); `None` for the explicit schemes.
     pub fn iteration_cap(self) -> Option<usize> {
         match self {
-            Self::Vbd => Some(vbd::MAX_ITERATIONS),
+            Self::Vbd => Some(StopRule::VBD.iterations),
             Self::Implicit => Some(implicit::CG_MAX_ITERATIONS),
             _ => None,
         }
@@ -226,6 +276,8 @@ pub struct Workspace {
     pub(crate) air: AirForces,
     /// The force loop's compilation, when not the detected one.
     pub(crate) kernel: Option<Kernel>,
+    /// How block descent ends a step, when not its default.
+    pub(crate) stop: Option<StopRule>,
 }
 
 impl Workspace {
@@ -252,9 +304,31 @@ impl Workspace {
     }
 
     /// The last block-descent step's residual: the largest force left on a free particle
-    /// over its weight (docs/physics.md §4.1; 0 for other integrators).
+    /// over its weight (docs/physics.md §4.1; 0 for other integrators, and unless asked
+    /// for with [`crate::Simulation::measure_residuals`]).
     pub fn vbd_residual(&self) -> f64 {
         self.vbd.residual
+    }
+
+    /// The largest move of the last block-descent step's last iteration over the step,
+    /// m/s: what its [`StopRule`] compares with its tolerance.
+    pub fn vbd_last_speed(&self) -> f64 {
+        self.vbd.last_speed
+    }
+
+    /// Parts the last block-descent step was taken in (one unless a collider or pins move).
+    pub fn vbd_parts(&self) -> u32 {
+        self.vbd.step_parts
+    }
+
+    /// Where block descent's time went, summed over the steps so far.
+    pub fn solve_times(&self) -> SolveTimes {
+        self.vbd.times
+    }
+
+    /// The rule block descent ends its steps by.
+    pub fn stop_rule(&self) -> StopRule {
+        self.stop.unwrap_or(StopRule::VBD)
     }
 
     /// Lays out `model`'s springs and sizes the buffers `integrator` uses for `particles`

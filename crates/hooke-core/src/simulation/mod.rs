@@ -155,6 +155,18 @@ impl Simulation {
         }
     }
 
+    /// Ends block descent's steps by `rule` instead of its defaults
+    /// ([`crate::StopRule::VBD`]).
+    pub fn set_stop_rule(&mut self, rule: crate::StopRule) {
+        self.workspace.stop = Some(rule);
+    }
+
+    /// Whether block descent measures each step's residual (a sweep's cost; the benchmark
+    /// reports it as evidence).
+    pub fn measure_residuals(&mut self, on: bool) {
+        self.workspace.vbd.evidence = on;
+    }
+
     /// The integrators' buffers (for figures such as [`Workspace::cg_iterations`]).
     pub fn workspace(&self) -> &Workspace {
         &self.workspace
@@ -211,11 +223,14 @@ impl Simulation {
         self.particles = r.particles(&self.particles);
         self.initial = r.particles(&self.initial);
         r.model(&mut self.model);
-        let kernel = self.workspace.kernel;
+        let (kernel, stop) = (self.workspace.kernel, self.workspace.stop);
+        let evidence = self.workspace.vbd.evidence;
         self.workspace = Workspace {
             kernel,
+            stop,
             ..Workspace::default()
         };
+        self.workspace.vbd.evidence = evidence;
         self.workspace
             .ensure(&self.model, self.particles.len(), self.integrator);
         self.contacts = ContactState::new(self.particles.len());

@@ -17,13 +17,13 @@
 //! bounds by the reach, which is enough for the same argument. The bound holds whatever the
 //! step size: the integrator can fail to converge, never cross.
 
+use super::candidates::{Candidates, SKIN, search};
 use super::graph::Graph;
 use super::pairs::{Pair, Sides, stencil_distance};
 use super::planes::{HalfSpaces, Plane, Touches};
 use crate::collider::response::Response;
 use crate::contact::grid::{Cell, Grid};
 use crate::contact::proximity::feature_triangle;
-use crate::contact::proximity::{point_triangle, segment_segment};
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
 use rayon::prelude::*;
@@ -83,13 +83,13 @@ impl Clearance {
 
 /// The surfaces' primitives, fixed for a model.
 #[derive(Clone, Debug, Default)]
-struct Topology {
+pub(super) struct Topology {
     built_for: usize,
     /// Active surfaces' triangles and edges, with their surface's index.
-    triangles: Vec<([u32; 3], u16)>,
-    edges: Vec<([u32; 2], u16)>,
+    pub(super) triangles: Vec<([u32; 3], u16)>,
+    pub(super) edges: Vec<([u32; 2], u16)>,
     /// Per particle: its active surface, or `u16::MAX`.
-    surface: Vec<u16>,
+    pub(super) surface: Vec<u16>,
     /// Whether any surface pair (self or between bodies) can touch.
     self_pairs: bool,
     /// Per triangle: which of its edges (bits 0..3: ab, bc, ca) and corners (bits 3..6)
@@ -186,6 +186,8 @@ pub(super) struct Detection {
     scratch_collider: Vec<Clearance>,
     scratch_own: Vec<Clearance>,
     scratch_allowed: Vec<f64>,
+    /// Surface pairs kept between detections (see [`Candidates`]).
+    candidates: Candidates,
     /// The largest thickness of the active surfaces.
     h_max: f64,
     /// Per particle: how far a pinned surface particle moves over the step apart from the
@@ -219,17 +221,18 @@ pub(super) fn bounds_of(points: &[&Vec3]) -> (Vec3, Vec3) {
 }
 
 /// Whether point `p` lies in box `lo..hi` grown by `r`.
-fn within(p: &Vec3, (lo, hi): &(Vec3, Vec3), r: f64) -> bool {
+pub(super) fn within(p: &Vec3, (lo, hi): &(Vec3, Vec3), r: f64) -> bool {
     (0..3).all(|k| p[k] >= lo[k] - r && p[k] <= hi[k] + r)
 }
 
-fn boxes_within(a: &(Vec3, Vec3), b: &(Vec3, Vec3), r: f64) -> bool {
+/// Whether boxes `a` and `b` come within `r` of each other.
+pub(super) fn boxes_within(a: &(Vec3, Vec3), b: &(Vec3, Vec3), r: f64) -> bool {
     (0..3).all(|k| a.0[k] <= b.1[k] + r && b.0[k] <= a.1[k] + r)
 }
 
 /// Bins `boxes` into `grid` with cells as large as the largest box plus `reach`, so that
 /// everything within `reach` of a query lies in the 27 cells around it ([`by_cell`]).
-fn bin(grid: &mut Grid, boxes: &[(Vec3, Vec3)], reach: f64) {
+pub(super) fn bin(grid: &mut Grid, boxes: &[(Vec3, Vec3)], reach: f64) {
     let extent = boxes
         .iter()
         .map(|(lo, hi)| (hi - lo).max())
@@ -241,7 +244,7 @@ fn bin(grid: &mut Grid, boxes: &[(Vec3, Vec3)], reach: f64) {
 /// items of the 27 cells around that cell (every item whose low corner lies within one cell
 /// of the query's), gathered once per occupied cell. Results come in the order of (cell,
 /// query): fixed by the positions alone, never by threads.
-fn by_cell<T: Send>(
+pub(super) fn by_cell<T: Send>(
     grid: &Grid,
     cells: &[Cell],
     test: impl Fn(usize, &[u32], &mut Vec<T>) + Sync + Send,
@@ -379,7 +382,12 @@ impl Detection {
             .filter(|&i| !p.is_pinned(i))
             .map(|i| (y[i] - x[i]).norm())
             .fold(0.0, f64::max);
-        let collider_reach = (COLLIDER_REACH * h_max).max(4.0 * travel).max(1e-6);
+        // Without colliders nothing bounds a particle but the surfaces.
+        let collider_reach = if model.colliders.is_empty() {
+            f64::INFINITY
+        } else {
+            (COLLIDER_REACH * h_max).max(4.0 * travel).max(1e-6)
+        };
         self.detect_colliders(model, x, collider_reach);
         self.detect_features(model, x, collider_reach, dt);
         let allowed = self.collider_allowance(model);
@@ -471,6 +479,7 @@ impl Detection {
             return;
         }
         let scale = &self.scale;
+        let (points, touches) = (&self.point_collider, &self.touches);
         let found = chunked(triangles.len(), |range| {
             let mut out = Vec::new();
             for t in range {
@@ -479,6 +488,21 @@ impl Detection {
                 let (lo, hi) = bounds_of(&[a, b, c]);
                 let h = model.surfaces[s as usize].thickness;
                 let mut clearance = Clearance::new(reach);
+                // A feature is a point of a collider's surface, so it is at least as far
+                // from a corner as the nearest surface point is, and at least that less the
+                // triangle's size from the triangle: a triangle whose corners all see no
+                // surface within the reach plus its size has no feature within the reach
+                // (unless a corner is inside something, which its contacts then say).
+                let nearest = tri
+                    .iter()
+                    .map(|&i| points[i as usize].nearest)
+                    .fold(0.0, f64::max);
+                let size = (a - b).norm().max((b - c).norm()).max((c - a).norm());
+                let felt = tri.iter().any(|&i| touches[i as usize].count != 0);
+                if !felt && nearest - size >= reach {
+                    out.push((t, clearance, Vec::new()));
+                    continue;
+                }
                 let mut pairs = Vec::new();
                 for slot in model.colliders.iter().filter(|c| c.shape.has_features()) {
                     let (k, mu) = collider_law(
@@ -555,36 +579,25 @@ impl Detection {
             CONTACT_STIFFNESS * ids.iter().map(|&i| scale[i as usize]).fold(0.0, f64::max)
         };
         let rest = &self.rest;
-
-        // Points against triangles.
-        let tri_boxes: Vec<(Vec3, Vec3)> = topo
-            .triangles
-            .iter()
-            .map(|(t, _)| bounds_of(&t.map(|i| &x[i as usize]).each_ref().map(|p| *p)))
+        self.candidates.update(topo, x, reach);
+        if self.candidates.stale(reach) {
+            let built = reach + SKIN * reach;
+            let (point_tri, edge_edge) = search(
+                topo,
+                x,
+                built,
+                (&mut self.triangle_grid, &mut self.edge_grid),
+            );
+            self.candidates.rebuild(built, point_tri, edge_edge);
+        }
+        let (found, found_edges) = self.candidates.within(topo, x, reach);
+        let found: Vec<_> = found
+            .into_iter()
+            .filter_map(|(v, t, d)| {
+                let law = law(topo.surface[v as usize], topo.triangles[t as usize].1)?;
+                Some((v as usize, t, d, law.0, law.1))
+            })
             .collect();
-        bin(&mut self.triangle_grid, &tri_boxes, reach);
-        let grid = &self.triangle_grid;
-        let at: Vec<Cell> = x.iter().map(|p| grid.cell_of(p)).collect();
-        let found = by_cell(grid, &at, |v, candidates, out| {
-            let sv = topo.surface[v];
-            if sv == u16::MAX {
-                return;
-            }
-            let p = &x[v];
-            for &t in candidates {
-                let (tri, st) = topo.triangles[t as usize];
-                if tri.contains(&(v as u32)) || !within(p, &tri_boxes[t as usize], reach) {
-                    continue;
-                }
-                let Some((h, mu)) = law(sv, st) else { continue };
-                let [a, b, c] = tri.map(|i| &x[i as usize]);
-                let w = point_triangle(p, a, b, c);
-                let d = (p - (a * w[0] + b * w[1] + c * w[2])).norm();
-                if d < reach {
-                    out.push((v, t, d, h, mu));
-                }
-            }
-        });
         for (v, t, d, h, mu) in found {
             let tri = topo.triangles[t as usize].0;
             let felt = d <= FELT * h;
@@ -613,49 +626,13 @@ impl Detection {
             }
         }
 
-        // Edges against edges, each unordered pair once (the later edge finds the earlier).
-        let edge_boxes: Vec<(Vec3, Vec3)> = topo
-            .edges
-            .iter()
-            .map(|([a, b], _)| {
-                (
-                    x[*a as usize].inf(&x[*b as usize]),
-                    x[*a as usize].sup(&x[*b as usize]),
-                )
+        let found: Vec<_> = found_edges
+            .into_iter()
+            .filter_map(|(e, f, d)| {
+                let law = law(topo.edges[e as usize].1, topo.edges[f as usize].1)?;
+                Some((e as usize, f as usize, d, law.0, law.1))
             })
             .collect();
-        bin(&mut self.edge_grid, &edge_boxes, reach);
-        let grid = &self.edge_grid;
-        let at: Vec<Cell> = edge_boxes.iter().map(|(lo, _)| grid.cell_of(lo)).collect();
-        let found = by_cell(grid, &at, |e, candidates, out| {
-            let ([a, b], se) = topo.edges[e];
-            let bx = &edge_boxes[e];
-            for &f in candidates {
-                let f = f as usize;
-                if f >= e {
-                    continue;
-                }
-                let ([c0, d0], sf) = topo.edges[f];
-                if [c0, d0].contains(&a) || [c0, d0].contains(&b) {
-                    continue;
-                }
-                if !boxes_within(bx, &edge_boxes[f], reach) {
-                    continue;
-                }
-                let Some((h, mu)) = law(se, sf) else { continue };
-                let (p1, q1, p2, q2) = (
-                    &x[a as usize],
-                    &x[b as usize],
-                    &x[c0 as usize],
-                    &x[d0 as usize],
-                );
-                let (s, t) = segment_segment(p1, q1, p2, q2);
-                let d = ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm();
-                if d < reach {
-                    out.push((e, f, d, h, mu));
-                }
-            }
-        });
         for (e, f, d, h, mu) in found {
             let felt = d <= FELT * h;
             let ([a, b], _) = topo.edges[e];

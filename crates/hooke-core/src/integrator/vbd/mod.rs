@@ -14,12 +14,14 @@
 //!   sweeps to make on a stiff sheet.
 //! * Every update is clipped to its particle's ball from the last detection (`detect.rs`),
 //!   and kept on the free side of the half-space colliders near it (bounding only the
-//!   motion into them, so particles slide along planes);
-//!   an iteration that clipped any particle ends with a new detection.
-//! * The step stops when an iteration moves no particle more than [`TOLERANCE`] of the
-//!   step's largest displacement (and clipped none), or after [`MAX_ITERATIONS`]. Then
+//!   motion into them, so particles slide along planes).
+//! * An iteration that leaves a hundredth of the particles waiting at their bounds ends
+//!   with a new detection; fewer wait there until the next step's.
+//! * The step stops when its last iteration moved no particle faster than the tolerance of
+//!   its [`StopRule`] (a velocity: the move over `dt`), or at its iteration budget. Then
 //!   `v = (x - x₀) / dt`.
 
+mod candidates;
 mod detect;
 mod graph;
 mod local;
@@ -27,7 +29,7 @@ mod pairs;
 mod planes;
 pub(crate) mod swept;
 
-use super::{StepReport, Workspace};
+use super::{StepReport, StopRule, Workspace};
 use crate::integrator::Sym3;
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
@@ -38,17 +40,11 @@ use rayon::prelude::*;
 
 /// Block descent is implicit Euler: stable for every step.
 pub(super) const STABILITY_RADIUS: f64 = f64::INFINITY;
-/// Iterations at most per step.
-pub(super) const MAX_ITERATIONS: usize = 24;
-/// The step has converged when no particle moved more than this share of the step's
-/// largest displacement in the last iteration.
-pub(super) const TOLERANCE: f64 = 1e-4;
-/// Displacements below this (metres) count as converged whatever the step's scale.
-const FLOOR: f64 = 1e-10;
+/// The share of the free particles that must wait at their bounds before an iteration
+/// detects again (besides the detection at every step's start).
+const DETECT_SHARE: f64 = 0.01;
 /// The spectral radius assumed by the Chebyshev acceleration (0: none).
 const CHEBYSHEV: f64 = 0.9;
-/// Detections at most while the first guess is clipped.
-const GUESS_DETECTIONS: usize = 8;
 /// Particles per parallel chunk of a colour.
 const CHUNK: usize = 256;
 
@@ -77,11 +73,18 @@ pub(crate) struct VbdBuffers {
     pub(crate) detections: usize,
     /// Parts the last step was taken in (more than one only with a moving collider).
     pub(crate) step_parts: u32,
-    /// Whether the last step ended at [`MAX_ITERATIONS`] without meeting its stopping rule.
+    /// Whether the last step ended at its iteration budget without meeting its stopping rule.
     pub(crate) capped: bool,
     /// The last step's residual: the largest force left on a free particle at the end of
-    /// the step, over its weight (docs/physics.md §4.1).
+    /// the step, over its weight (docs/physics.md §4.1), when [`VbdBuffers::evidence`] asks
+    /// for it (it costs a sweep).
     pub(crate) residual: f64,
+    /// Whether to measure the residual.
+    pub(crate) evidence: bool,
+    /// The largest move of the last step's last iteration over the step, m/s.
+    pub(crate) last_speed: f64,
+    /// Where the steps' time went, summed.
+    pub(crate) times: crate::integrator::SolveTimes,
 }
 
 pub(super) fn step(
@@ -90,6 +93,8 @@ pub(super) fn step(
     (t, dt): (f64, f64),
     ws: &mut Workspace,
 ) -> StepReport {
+    let mut clock = crate::integrator::Lap::start();
+    let rule = ws.stop.unwrap_or(StopRule::VBD);
     let n = p.len();
     ws.x0.copy_from_slice(&p.x);
     let air = ws
@@ -122,6 +127,8 @@ pub(super) fn step(
             p.x[i] + p.v[i] * dt + f * (dt * dt / p.mass[i])
         });
     }
+    // The targets are the step's, not the solve's: their time is the rest's.
+    let _ = clock.lap();
     b.detection
         .detect(model, p, &b.graph, (&p.x, &b.target), dt);
     // A keyframed pin moves at its velocity over the step (docs/physics.md §1.2): implicit
@@ -136,44 +143,23 @@ pub(super) fn step(
     b.detected.clear();
     b.detected.extend_from_slice(&p.x);
     b.detections = 1;
-    // The first guess (after Chen et al. 2024's adaptive one): the inertial motion with as much of
-    // gravity as the particle showed last step (none for a cloth at rest on a table, all of
-    // it in free fall), clipped; while the clipping holds the guess back, detected anew
-    // from where it got to (a fast fall crosses several bounds in one step).
+    // The first guess (after Chen et al. 2024's adaptive one): the inertial motion with as
+    // much of gravity as the particle showed last step (none for a cloth at rest on a table,
+    // all of it in free fall), clipped to the bounds of the step's detection.
     let g = model.gravity.norm();
     let fresh = b.previous.len() != n;
-    b.next.clear();
-    b.next.extend((0..n).map(|i| {
+    for i in 0..n {
+        if p.is_pinned(i) {
+            continue;
+        }
         let share = if fresh || g == 0.0 {
             1.0
         } else {
             let a = (p.v[i] - b.previous[i]) / dt;
             (a.dot(&model.gravity) / (g * g)).clamp(0.0, 1.0)
         };
-        (
-            p.x[i] + p.v[i] * dt + model.gravity * (share * dt * dt),
-            false,
-        )
-    }));
-    for round in 0..GUESS_DETECTIONS {
-        let mut clipped = false;
-        for i in 0..n {
-            // Past the first round only particles that feel no contact follow the guess:
-            // it knows nothing of contacts, and would drag a particle into one a bound
-            // at a time.
-            if !p.is_pinned(i) && (round == 0 || !b.detection.may_touch(i)) {
-                let (x, c) = clip(&b.detection, &b.detected, i, b.next[i].0);
-                p.x[i] = x;
-                clipped |= c;
-            }
-        }
-        if !clipped || round + 1 == GUESS_DETECTIONS {
-            break;
-        }
-        b.detection
-            .detect(model, p, &b.graph, (&p.x, &b.target), dt);
-        b.detected.copy_from_slice(&p.x);
-        b.detections += 1;
+        let guess = p.x[i] + p.v[i] * dt + model.gravity * (share * dt * dt);
+        p.x[i] = clip(&b.detection, &b.detected, i, guess).0;
     }
     recolour(&mut b.graph, &b.detection, p);
     b.previous.clear();
@@ -182,15 +168,21 @@ pub(super) fn step(
     b.older.extend_from_slice(&p.x);
     b.old.clear();
     b.old.extend_from_slice(&p.x);
+    b.times.detection += clock.lap();
+    let free = (0..n).filter(|&i| !p.is_pinned(i)).count();
+    // Detect again when this many particles wait at their bounds (Chen et al. 2025 detect
+    // again at 1 % of the vertices): fewer wait there until the next step.
+    let enough = ((DETECT_SHARE * free as f64).ceil() as usize).max(1);
     let mut omega = 1.0;
     let mut since_detection = 0;
     let start = &ws.x0;
     let mut iterations = 0;
     let mut converged = false;
-    while iterations < MAX_ITERATIONS {
+    let mut last_move = 0.0;
+    while iterations < rule.iterations {
         iterations += 1;
         let mut largest = 0.0_f64;
-        let mut clipped = false;
+        let mut held = 0;
         let local = Local {
             model,
             graph: &b.graph,
@@ -220,26 +212,27 @@ pub(super) fn step(
             for (&i, &(xi, c)) in colour.iter().zip(&b.next) {
                 let i = i as usize;
                 largest = largest.max((xi - p.x[i]).norm());
-                clipped |= c;
+                held += usize::from(c);
                 p.x[i] = xi;
             }
         }
+        b.times.sweeps += clock.lap();
         let (moved, c) = translate_bodies(&local, &b.detected, &mut b.parts, &mut p.x);
         largest = largest.max(moved);
-        clipped |= c;
-        let scale =
-            p.x.iter()
-                .zip(start)
-                .map(|(x, s)| (x - s).norm())
-                .fold(0.0, f64::max);
-        if !clipped && largest <= TOLERANCE * scale.max(g * dt * dt) + FLOOR {
+        held += c;
+        b.times.coarse += clock.lap();
+        last_move = largest;
+        // The anchors' rule (IPC's): the step is solved when its last update moved no
+        // particle faster than the tolerance over the step, and none waits at its bound.
+        let settled = largest <= rule.tolerance * dt;
+        if settled && held == 0 {
             converged = true;
             break;
         }
         // Chebyshev semi-iterative acceleration (Wang 2015, as Chen et al. 2024 use it),
         // restarted at each detection; each result clipped again.
         since_detection += 1;
-        if since_detection >= 2 && CHEBYSHEV > 0.0 && iterations < MAX_ITERATIONS {
+        if since_detection >= 2 && CHEBYSHEV > 0.0 && iterations < rule.iterations {
             omega = if since_detection == 2 {
                 2.0 / (2.0 - CHEBYSHEV * CHEBYSHEV)
             } else {
@@ -255,7 +248,10 @@ pub(super) fn step(
         }
         std::mem::swap(&mut b.older, &mut b.old);
         b.old.copy_from_slice(&p.x);
-        if clipped && iterations < MAX_ITERATIONS {
+        b.times.acceleration += clock.lap();
+        // Detect again when enough particles wait at their bounds, or when they are all
+        // that is left to move.
+        if (held >= enough || (settled && held > 0)) && iterations < rule.iterations {
             b.detection
                 .detect(model, p, &b.graph, (&p.x, &b.target), dt);
             recolour(&mut b.graph, &b.detection, p);
@@ -263,24 +259,28 @@ pub(super) fn step(
             b.detections += 1;
             since_detection = 0;
             b.older.copy_from_slice(&p.x);
+            b.times.detection += clock.lap();
         }
     }
     b.iterations = iterations;
     b.step_parts = 1;
     b.capped = !converged;
-    b.residual = residual(
-        &Local {
-            model,
-            graph: &b.graph,
-            detection: &b.detection,
-            mass: &p.mass,
-            start,
-            target: &b.target,
-            dt,
-        },
-        p,
-        g,
-    );
+    b.last_speed = last_move / dt;
+    if b.evidence {
+        b.residual = residual(
+            &Local {
+                model,
+                graph: &b.graph,
+                detection: &b.detection,
+                mass: &p.mass,
+                start,
+                target: &b.target,
+                dt,
+            },
+            p,
+            g,
+        );
+    }
     for (i, (v, (x, s))) in p.v.iter_mut().zip(p.x.iter().zip(start)).enumerate() {
         if p.inv_mass[i] != 0.0 {
             *v = (x - s) / dt;
@@ -296,14 +296,14 @@ pub(super) fn step(
 /// springs' terms (which cancel for a translation), every particle clipped to its bounds. Gauss–Seidel
 /// moves a stiff sheet as a whole by about `m/dt² / Σ ks` of the way per sweep; this moves
 /// it all the way in one. Sums in fixed chunks, in order: the same bits on any thread count.
-/// Returns the largest move and whether any particle was clipped.
+/// Returns the largest move and how many particles were clipped.
 fn translate_bodies(
     local: &Local<'_>,
     detected: &[Vec3],
     parts: &mut Vec<(Vec3, Sym3)>,
     x: &mut [Vec3],
-) -> (f64, bool) {
-    let (mut largest, mut clipped) = (0.0f64, false);
+) -> (f64, usize) {
+    let (mut largest, mut clipped) = (0.0f64, 0);
     let graph = local.graph;
     for (k, body) in graph.free_bodies.iter().enumerate() {
         // A body touching another is left to the sweeps (see `mark_touching_bodies`).
@@ -343,7 +343,7 @@ fn translate_bodies(
             let i = i as usize;
             let (to, c) = clip(local.detection, detected, i, x[i] + d);
             largest = largest.max((to - x[i]).norm());
-            clipped |= c;
+            clipped += usize::from(c);
             x[i] = to;
         }
     }

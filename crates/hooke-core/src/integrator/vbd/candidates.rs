@@ -1,0 +1,285 @@
+//! Surface pairs kept between detections (a Verlet list with travel budgets, as the contact
+//! phase keeps its own, docs/physics.md §3.3 and §4.1): every point–triangle and edge–edge
+//! pair of the surfaces within `reach + skin` at a build, with the distance at its last
+//! exact test. Each surface particle's *travel* — the path its position took relative to the
+//! surfaces' mean motion, summed over the detections since the build — bounds how far any
+//! gap can have closed:
+//!
+//! * a listed pair last measured at `d` while its particles' travel summed to `T₀` is still
+//!   at least `d - (T - T₀)` apart when they sum to `T`, and is not tested again while that
+//!   is at least the reach: what it would give is known (beyond the reach, unseen);
+//! * a pair left out of the list was at least `reach + skin` apart at the build, and its
+//!   gap has closed by at most twice the largest travel since: the list holds every pair
+//!   within the reach while the largest travel stays under half the skin, and is built
+//!   again when it does not (or when the reach grows past what it was built for).
+//!
+//! So a detection finds exactly the pairs within its reach, with their exact distances, as
+//! a search over every pair would: only the order of the list (the build's, fixed by the
+//! positions then) differs, and no thread count changes it.
+
+use super::detect::{Topology, bin, bounds_of, boxes_within, by_cell, within};
+use crate::contact::grid::{Cell, Grid};
+use crate::contact::proximity::{point_triangle, segment_segment};
+use crate::particles::Vec3;
+use rayon::prelude::*;
+
+/// The skin of a build, as a share of the reach it serves.
+pub(super) const SKIN: f64 = 1.0;
+
+/// Candidates tested per parallel chunk.
+const CHUNK: usize = 4096;
+
+/// One listed pair: its two primitives (a particle and a triangle, or two edges), the
+/// distance at its last exact test and its particles' travel summed then.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Candidate {
+    a: u32,
+    b: u32,
+    distance: f64,
+    travel: f64,
+}
+
+/// The list and the travel since its build.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Candidates {
+    /// The reach the list holds every pair within, at the build.
+    built: f64,
+    /// Whether a list was built for the current topology.
+    valid: bool,
+    /// Per particle: travel since the build, relative to the surfaces' mean motion.
+    travel: Vec<f64>,
+    /// The largest of it.
+    most: f64,
+    /// Positions and their surfaces' mean at the last detection.
+    last: Vec<Vec3>,
+    last_mean: Vec3,
+    point_tri: Vec<Candidate>,
+    edge_edge: Vec<Candidate>,
+}
+
+/// The mean of the surface particles' positions (zero without any).
+fn surface_mean(topo: &Topology, x: &[Vec3]) -> Vec3 {
+    let (mut sum, mut count) = (Vec3::zeros(), 0usize);
+    for (i, p) in x.iter().enumerate() {
+        if topo.surface[i] != u16::MAX {
+            sum += p;
+            count += 1;
+        }
+    }
+    if count == 0 { sum } else { sum / count as f64 }
+}
+
+impl Candidates {
+    /// Adds the motion since the last detection to each surface particle's travel.
+    pub(super) fn update(&mut self, topo: &Topology, x: &[Vec3], reach: f64) {
+        let mean = surface_mean(topo, x);
+        if !self.valid || self.last.len() != x.len() || !reach.is_finite() {
+            self.valid = false;
+            self.last_mean = mean;
+            self.last.clear();
+            self.last.extend_from_slice(x);
+            return;
+        }
+        let shift = mean - self.last_mean;
+        let mut most = self.most;
+        for (i, (t, (p, q))) in self
+            .travel
+            .iter_mut()
+            .zip(x.iter().zip(&self.last))
+            .enumerate()
+        {
+            if topo.surface[i] != u16::MAX {
+                *t += (p - q - shift).norm();
+                most = most.max(*t);
+            }
+        }
+        self.most = most;
+        self.last.copy_from_slice(x);
+        self.last_mean = mean;
+    }
+
+    /// Whether the list may miss a pair within `reach` (see the module docs).
+    pub(super) fn stale(&self, reach: f64) -> bool {
+        !self.valid || 2.0 * self.most >= self.built - reach
+    }
+
+    /// Keeps `point_tri` and `edge_edge`, measured now, as every pair within `built`.
+    pub(super) fn rebuild(
+        &mut self,
+        built: f64,
+        point_tri: Vec<Candidate>,
+        edge_edge: Vec<Candidate>,
+    ) {
+        self.built = built;
+        self.valid = true;
+        self.travel.clear();
+        self.travel.resize(self.last.len(), 0.0);
+        self.most = 0.0;
+        self.point_tri = point_tri;
+        self.edge_edge = edge_edge;
+    }
+
+    /// The pairs within `reach` at `x`, in the list's order: `(point, triangle, distance)`
+    /// and `(edge, earlier edge, distance)`. A pair whose budget shows it beyond the reach
+    /// is not measured; every other is, and its distance and travel kept.
+    #[allow(clippy::type_complexity)]
+    pub(super) fn within(
+        &mut self,
+        topo: &Topology,
+        x: &[Vec3],
+        reach: f64,
+    ) -> (Vec<(u32, u32, f64)>, Vec<(u32, u32, f64)>) {
+        let travel = &self.travel;
+        let points = check(
+            &mut self.point_tri,
+            reach,
+            |c| {
+                let (tri, _) = topo.triangles[c.b as usize];
+                travel[c.a as usize] + tri.iter().map(|&i| travel[i as usize]).sum::<f64>()
+            },
+            |c| {
+                let (tri, _) = topo.triangles[c.b as usize];
+                let [a, b, cc] = tri.map(|i| &x[i as usize]);
+                let p = &x[c.a as usize];
+                let w = point_triangle(p, a, b, cc);
+                (p - (a * w[0] + b * w[1] + cc * w[2])).norm()
+            },
+        );
+        let ends = |c: &Candidate| {
+            let ([a, b], _) = topo.edges[c.a as usize];
+            let ([e, f], _) = topo.edges[c.b as usize];
+            [a, b, e, f]
+        };
+        let edges = check(
+            &mut self.edge_edge,
+            reach,
+            |c| ends(c).iter().map(|&i| travel[i as usize]).sum::<f64>(),
+            |c| {
+                let [p1, q1, p2, q2] = ends(c).map(|i| &x[i as usize]);
+                let (s, u) = segment_segment(p1, q1, p2, q2);
+                ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * u)).norm()
+            },
+        );
+        (points, edges)
+    }
+}
+
+/// Checks the candidates in fixed chunks: each whose budget (its particles' travel summed
+/// now, `travel`) does not keep it beyond `reach` is measured (`measure`), and returned when
+/// within it. Results in list order.
+fn check(
+    list: &mut [Candidate],
+    reach: f64,
+    travel: impl Fn(&Candidate) -> f64 + Sync,
+    measure: impl Fn(&Candidate) -> f64 + Sync,
+) -> Vec<(u32, u32, f64)> {
+    let run = |chunk: &mut [Candidate]| {
+        let mut out = Vec::new();
+        for c in chunk {
+            let t = travel(c);
+            if c.distance - (t - c.travel) >= reach {
+                continue;
+            }
+            c.distance = measure(c);
+            c.travel = t;
+            if c.distance < reach {
+                out.push((c.a, c.b, c.distance));
+            }
+        }
+        out
+    };
+    if list.len() <= CHUNK {
+        return run(list);
+    }
+    let parts: Vec<Vec<(u32, u32, f64)>> = list.par_chunks_mut(CHUNK).map(run).collect();
+    parts.into_iter().flatten().collect()
+}
+
+/// Every point–triangle pair (a surface particle, a triangle not holding it) and edge–edge
+/// pair (sharing no particle; each unordered pair once) of the surfaces within `reach` at
+/// `x`, measured, through the grids' search.
+pub(super) fn search(
+    topo: &Topology,
+    x: &[Vec3],
+    reach: f64,
+    (triangle_grid, edge_grid): (&mut Grid, &mut Grid),
+) -> (Vec<Candidate>, Vec<Candidate>) {
+    let tri_boxes: Vec<(Vec3, Vec3)> = topo
+        .triangles
+        .iter()
+        .map(|(t, _)| bounds_of(&t.map(|i| &x[i as usize]).each_ref().map(|p| *p)))
+        .collect();
+    bin(triangle_grid, &tri_boxes, reach);
+    let grid = &*triangle_grid;
+    let at: Vec<Cell> = x.iter().map(|p| grid.cell_of(p)).collect();
+    let point_tri = by_cell(grid, &at, |v, candidates, out| {
+        if topo.surface[v] == u16::MAX {
+            return;
+        }
+        let p = &x[v];
+        for &t in candidates {
+            let (tri, _) = topo.triangles[t as usize];
+            if tri.contains(&(v as u32)) || !within(p, &tri_boxes[t as usize], reach) {
+                continue;
+            }
+            let [a, b, c] = tri.map(|i| &x[i as usize]);
+            let w = point_triangle(p, a, b, c);
+            let d = (p - (a * w[0] + b * w[1] + c * w[2])).norm();
+            if d < reach {
+                out.push(Candidate {
+                    a: v as u32,
+                    b: t,
+                    distance: d,
+                    travel: 0.0,
+                });
+            }
+        }
+    });
+    let edge_boxes: Vec<(Vec3, Vec3)> = topo
+        .edges
+        .iter()
+        .map(|([a, b], _)| {
+            (
+                x[*a as usize].inf(&x[*b as usize]),
+                x[*a as usize].sup(&x[*b as usize]),
+            )
+        })
+        .collect();
+    bin(edge_grid, &edge_boxes, reach);
+    let grid = &*edge_grid;
+    let at: Vec<Cell> = edge_boxes.iter().map(|(lo, _)| grid.cell_of(lo)).collect();
+    let edge_edge = by_cell(grid, &at, |e, candidates, out| {
+        let ([a, b], _) = topo.edges[e];
+        let bx = &edge_boxes[e];
+        for &f in candidates {
+            let f = f as usize;
+            if f >= e {
+                continue;
+            }
+            let ([c0, d0], _) = topo.edges[f];
+            if [c0, d0].contains(&a) || [c0, d0].contains(&b) {
+                continue;
+            }
+            if !boxes_within(bx, &edge_boxes[f], reach) {
+                continue;
+            }
+            let (p1, q1, p2, q2) = (
+                &x[a as usize],
+                &x[b as usize],
+                &x[c0 as usize],
+                &x[d0 as usize],
+            );
+            let (s, t) = segment_segment(p1, q1, p2, q2);
+            let d = ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm();
+            if d < reach {
+                out.push(Candidate {
+                    a: e as u32,
+                    b: f as u32,
+                    distance: d,
+                    travel: 0.0,
+                });
+            }
+        }
+    });
+    (point_tri, edge_edge)
+}
