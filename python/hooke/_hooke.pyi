@@ -82,8 +82,14 @@ def load(
     table: Optional[str] = None,
     threads: Optional[int] = None,
     set: Optional[dict[str, object]] = None,
+    tolerance: Optional[float] = None,
+    iterations: Optional[int] = None,
 ) -> Simulation:
-    """A built-in scene, .toml scene or .w world, with the command line's overrides."""
+    """A built-in scene, .toml scene or .w world, with the command line's overrides.
+
+    `tolerance` (m/s) and `iterations` are the large-step integrators' stopping rule
+    (`vbd`, `newton`): a step ends when its last update moved no free particle more than
+    `tolerance * dt`, or after `iterations` updates."""
 
 def scenes() -> list[tuple[str, str]]: ...
 def report(dir: str | os.PathLike[str], *, quick: bool = False) -> tuple[str, list[str]]: ...

@@ -506,7 +506,7 @@ fn toml_value(value: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
 /// with the command line's overrides, and `set`, a dict of scene-file keys to values
 /// (`{"body.springs.structural.ks": 500.0}`) applied before the overrides.
 #[pyfunction]
-#[pyo3(signature = (source, *, dt = None, integrator = None, steps = None, duration = None, every = None, table = None, threads = None, set = None))]
+#[pyo3(signature = (source, *, dt = None, integrator = None, steps = None, duration = None, every = None, table = None, threads = None, set = None, tolerance = None, iterations = None))]
 #[allow(clippy::too_many_arguments)]
 fn load(
     source: &str,
@@ -518,6 +518,8 @@ fn load(
     table: Option<&str>,
     threads: Option<i64>,
     set: Option<&Bound<'_, PyDict>>,
+    tolerance: Option<f64>,
+    iterations: Option<i64>,
 ) -> PyResult<Simulation> {
     let integrator = integrator
         .map(|name| name.parse::<Integrator>())
@@ -535,6 +537,17 @@ fn load(
     let every = every
         .map(|n| whole(n, "every", 1, hooke_scene::MAX_STEPS))
         .transpose()?;
+    let iterations = iterations
+        .map(|n| whole(n, "iterations", 1, u64::MAX))
+        .transpose()?;
+    let tolerance = match tolerance {
+        Some(t) if !(t.is_finite() && t > 0.0) => {
+            return Err(HookeError::new_err(format!(
+                "tolerance: expected a finite speed in m/s > 0, found {t}"
+            )));
+        }
+        t => t,
+    };
     let table = table.map(source::table).transpose().map_err(error)?;
     let overrides = Overrides {
         integrator,
@@ -543,6 +556,8 @@ fn load(
         duration: positive("duration", duration)?,
         every,
         table,
+        tolerance,
+        iterations,
     };
     let mut read = source::read(source).map_err(error)?;
     if let Some(set) = set {
