@@ -442,11 +442,12 @@ friction = 0.0
     assert!((x.x - 2.0).abs() < 0.05, "travelled {} m", x.x);
 }
 
-/// Issue 54: block descent does not converge on the jello worlds at 1/60 s, nor on the
-/// jelly cube's landing; converged, its steps would only take energy out, so a gain beyond a
-/// hundredth of the start's energy scale stops the run as diverged, naming the energy,
-/// instead of ending it with exit 0 flattened against a wall (`jello.w` used to end at
-/// 2147 J from 345 J, `moveLeft.w` at 8000 J from 1250 J).
+/// Issue 54: a converged implicit step only takes energy out, so a gain beyond a hundredth
+/// of the start's energy scale stops the run as diverged, naming the energy, instead of
+/// ending it with exit 0: the built-in jelly cube (no contact thickness, dropped onto a
+/// restitution ground) gains energy on its landing at 1/60 s. (The jello worlds, which
+/// block descent used to flatten against their walls, keep their shape since the penalty
+/// walls' damping is read at the step's start: `newton.rs`, docs/physics.md §4.1.)
 #[test]
 fn block_descent_stops_rather_than_end_a_stiff_body_wrong() {
     let at_60 = Overrides {
@@ -454,14 +455,6 @@ fn block_descent_stops_rather_than_end_a_stiff_body_wrong() {
         dt: Some(1.0 / 60.0),
         ..Overrides::default()
     };
-    for world in ["jello", "moveLeft"] {
-        let mut spec = crate::worlds::world(world).to_scene(world).unwrap();
-        at_60.apply(&mut spec).unwrap();
-        let mut scene = spec.build(std::path::Path::new(".")).unwrap();
-        let steps = scene.steps;
-        let e = scene.simulation.advance(steps).unwrap_err().to_string();
-        assert!(e.contains("the energy grew"), "{world}: {e}");
-    }
     let mut cube = crate::common::builtin("jello-cube", &at_60);
     let steps = cube.steps;
     let e = cube.simulation.advance(steps).unwrap_err().to_string();

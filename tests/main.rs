@@ -15,6 +15,7 @@ mod large_steps;
 mod layout;
 mod material;
 mod motion;
+mod newton;
 mod oscillator;
 mod roundtrip;
 mod scenes;

@@ -520,7 +520,7 @@ fn scene_steps(
     use_kernel(sim, kernel)?;
     sim.measure_residuals(residual);
     let times_before = sim.workspace().solve_times();
-    let from_start = matches!(sim.integrator(), Integrator::Implicit | Integrator::Vbd);
+    let from_start = sim.integrator() == Integrator::Implicit || sim.integrator().solves_contacts();
     let steps = match steps {
         Some(n) => n,
         None if from_start => whole_run,
@@ -545,7 +545,7 @@ fn scene_steps(
         parts += u64::from(w.vbd_parts());
     })?;
     let contacts = sim.contact_stats();
-    let vbd = sim.integrator() == Integrator::Vbd;
+    let vbd = sim.integrator().solves_contacts();
     let split = vbd.then(|| {
         let now = sim.workspace().solve_times();
         let part = |a: std::time::Duration, b: std::time::Duration| (a - b).as_secs_f64();
@@ -562,7 +562,7 @@ fn scene_steps(
         }
     });
     final_speeds.sort_by(f64::total_cmp);
-    let rule = sim.workspace().stop_rule();
+    let rule = sim.workspace().stop_rule_of(sim.integrator());
     let figures = SceneFigures {
         cg_iterations_per_step: cg_iterations as f64 / steps as f64,
         vbd_iterations_per_step: vbd_iterations as f64 / steps as f64,

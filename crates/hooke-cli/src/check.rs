@@ -56,12 +56,15 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
     if let Some(advice) = large_step_advice(&scene, &estimate) {
         println!("{advice}");
     }
-    if sim.integrator() == Integrator::Vbd {
-        for message in crate::risks::volumetric_bodies(&scene) {
-            println!("warning: {message}");
+    if sim.integrator().solves_contacts() {
+        let name = sim.integrator().name();
+        if sim.integrator() == Integrator::Vbd {
+            for message in crate::risks::volumetric_bodies(&scene) {
+                println!("warning: {message}");
+            }
         }
         println!(
-            "vbd guarantees: stability at any dt; no surface crosses a still collider or \
+            "{name} guarantees: stability at any dt; no surface crosses a still collider or \
              another surface at any dt (every update is bounded, docs/physics.md §4.1); a \
              moving collider or keyed pins are followed in parts of the step, down to dt/{}, \
              and where a pinned or squeezed particle lies in a moving collider's path, where \
@@ -70,10 +73,15 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
              it stops as diverged",
             hooke_core::MOST_PARTS
         );
-        let rule = sim.workspace().stop_rule();
+        let rule = sim.workspace().stop_rule_of(sim.integrator());
+        let update = if sim.integrator() == Integrator::Newton {
+            "Newton step (before its line search)"
+        } else {
+            "iteration"
+        };
         println!(
-            "vbd does not guarantee: a solved step. A step ends when its last iteration moved \
-             no particle faster than {} m/s (--tolerance), or after {} iterations \
+            "{name} does not guarantee: a solved step. A step ends when its last {update} \
+             moved no particle faster than {} m/s (--tolerance), or after {} iterations \
              (--iterations) whether or not it got there; `hooke bench scene` counts the steps \
              at the budget and the final update's speed. Contacts are inelastic (cr has no \
              effect), and a particle slides along a mesh or cylinder collider at most about \

@@ -88,11 +88,12 @@ enum Command {
 /// Options that change what is simulated.
 #[derive(Args, Clone, Default)]
 struct SetupArgs {
-    /// Integrator: euler, symplectic, midpoint, rk4, implicit or vbd (block descent: one
+    /// Integrator: euler, symplectic, midpoint, rk4, implicit, vbd (block descent: one
     /// implicit step per display frame that keeps every surface out of still colliders and
     /// other surfaces; a pinned or squeezed particle in a moving collider's path cannot be,
-    /// and the run warns when one is, docs/physics.md §4.1). `hooke check` says what each
-    /// integrator promises for a scene.
+    /// and the run warns when one is, docs/physics.md §4.1) or newton (the same step solved
+    /// by Newton's method: for stiff and volumetric bodies, §4.2). `hooke check` says what
+    /// each integrator promises for a scene.
     #[arg(long)]
     integrator: Option<Integrator>,
     /// Step size in seconds.

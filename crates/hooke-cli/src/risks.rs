@@ -150,7 +150,7 @@ const TINY_STEP: f64 = 1.0 / 600.0;
 /// a display frame.
 pub(crate) fn large_step_advice(scene: &Scene, estimate: &StabilityEstimate) -> Option<String> {
     let sim = &scene.simulation;
-    if sim.integrator() == Integrator::Vbd
+    if sim.integrator().solves_contacts()
         || !scene.bodies.iter().any(|b| b.thickness > 0.0)
         || !volumetric_bodies(scene).is_empty()
     {
@@ -207,10 +207,10 @@ pub(crate) fn thin_surfaces(scene: &Scene) -> Vec<String> {
         .collect()
 }
 
-/// Warns on stderr about thin colliders a particle can cross in one step. Block descent
-/// bounds every update so that nothing crosses whatever the step: no warning for it.
+/// Warns on stderr about thin colliders a particle can cross in one step. Block descent and
+/// Newton bound every update so that nothing crosses whatever the step: no warning for them.
 pub(crate) fn warn_if_tunnelling(scene: &Scene) {
-    if scene.simulation.integrator() == Integrator::Vbd {
+    if scene.simulation.integrator().solves_contacts() {
         return;
     }
     let dt = scene.simulation.dt();
@@ -227,26 +227,45 @@ pub(crate) fn warn_if_tunnelling(scene: &Scene) {
     }
 }
 
-/// For block descent: the volumetric bodies (lattices), which it does not converge on at a
-/// display frame (a disturbance crosses about one colour of particles per iteration, and a
-/// jelly has no soft mode to give way), and which gain energy on landing even at small
-/// steps; the integrator to use instead, with its stable step.
+/// For block descent: the volumetric bodies (lattices), and the bodies whose springs are
+/// stiff against their inertia at this step (`ks dt² / m` above [`STIFF`]), which it
+/// converges on slowly (a disturbance crosses about one colour of particles per
+/// iteration); the integrator that solves the step globally instead.
 pub(crate) fn volumetric_bodies(scene: &Scene) -> Vec<String> {
-    let estimate = scene.simulation.stability();
-    let rk4 = estimate.max_dt(Integrator::Rk4);
+    let sim = &scene.simulation;
+    let dt = sim.dt();
+    let model = sim.model();
+    let masses = &sim.particles().mass;
     scene
         .bodies
         .iter()
-        .filter(|b| matches!(b.topology, hooke_scene::Topology::Lattice(_)))
-        .map(|b| {
-            format!(
-                "body '{}' is a volumetric lattice, which block descent does not converge on: \
-                 its runs stop when their energy grows (the jello worlds at 1/60 s, the \
-                 jelly cube on landing); use `--integrator rk4 --dt {:.3e}` (its stable \
-                 step's half)",
-                b.name,
-                0.5 * rk4
-            )
+        .filter_map(|b| {
+            let stiffness = model
+                .springs
+                .iter()
+                .filter(|s| b.range.contains(&(s.i as usize)))
+                .map(|s| s.ks * dt * dt / masses[s.i as usize].min(masses[s.j as usize]))
+                .filter(|r| r.is_finite())
+                .fold(0.0, f64::max);
+            let why = if matches!(b.topology, hooke_scene::Topology::Lattice(_)) {
+                "is a volumetric lattice".to_string()
+            } else if stiffness > STIFF {
+                format!("has springs with ks dt²/m up to {stiffness:.1e}")
+            } else {
+                return None;
+            };
+            Some(format!(
+                "body '{}' {why}, which block descent converges on slowly (a disturbance \
+                 crosses about one colour of particles per iteration; its steps end at their \
+                 budget); `--integrator newton` solves each step globally (docs/physics.md \
+                 §4.2)",
+                b.name
+            ))
         })
         .collect()
 }
+
+/// The `ks dt² / m` above which block descent's steps end at their budget on a strip or
+/// cloth (a 2000 N/m strip at 1 cm spacing is 1e5 at 1/60 s and diverged; the built-in
+/// cloths are below 1e3).
+const STIFF: f64 = 1e4;

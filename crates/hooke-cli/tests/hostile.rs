@@ -319,7 +319,8 @@ fn one_thread_is_one_thread() {
 }
 
 /// Block descent is not for volumetric bodies: `hooke check` says so for a lattice, with
-/// the integrator and step to use instead.
+/// the integrator to use instead (issue 56: Newton), whose own promises and stopping rule
+/// it states.
 #[test]
 fn check_says_block_descent_is_not_for_a_jelly() {
     let dir = scratch("check-jelly");
@@ -327,11 +328,19 @@ fn check_says_block_descent_is_not_for_a_jelly() {
     let said = String::from_utf8_lossy(&out.stdout);
     assert!(
         said.contains("warning: body 'jelly' is a volumetric lattice")
-            && said.contains("--integrator rk4 --dt"),
+            && said.contains("--integrator newton"),
         "{said}"
     );
     let out = hooke(&["check", "cloth-table", "--integrator", "vbd"], &dir);
     assert!(!String::from_utf8_lossy(&out.stdout).contains("volumetric"));
+    let out = hooke(&["check", "jello-cube", "--integrator", "newton"], &dir);
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        said.contains("newton guarantees: stability at any dt")
+            && said.contains("after 100 iterations")
+            && !said.contains("volumetric"),
+        "{said}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -164,11 +164,11 @@ pub struct SimulationSpec {
     /// same for a body at any resolution (default 0).
     #[serde(default = "zero", skip_serializing_if = "is_zero")]
     pub mass_drag: NonNegative,
-    /// Block descent's stopping tolerance, m/s: a step ends when its last iteration moved
-    /// no free particle by more than this times `dt` (default 0.01).
+    /// The large steps' stopping tolerance (`vbd`, `newton`), m/s: a step ends when its
+    /// last update moved no free particle by more than this times `dt` (default 0.01).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tolerance: Option<Positive>,
-    /// Block descent's iteration budget per step (default 24).
+    /// The large steps' iteration budget per step (default: `vbd` 24, `newton` 100).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub iterations: Option<u64>,
     /// The air that bodies with a surface (grids, lattices) move in: drag and lift per

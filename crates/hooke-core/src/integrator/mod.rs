@@ -8,6 +8,7 @@ mod blocks;
 mod euler;
 mod implicit;
 mod midpoint;
+mod newton;
 mod rk4;
 mod symplectic;
 mod vbd;
@@ -48,6 +49,12 @@ impl StopRule {
     pub const VBD: StopRule = StopRule {
         tolerance: 1e-2,
         iterations: 24,
+    };
+
+    /// Newton's defaults (chosen by measurement: benches/README.md).
+    pub const NEWTON: StopRule = StopRule {
+        tolerance: 1e-2,
+        iterations: 100,
     };
 }
 
@@ -101,17 +108,23 @@ pub enum Integrator {
     /// surface crosses a collider or another surface (docs/physics.md §4.1). Order 1; stable
     /// for any `dt`, damps; contacts at the bodies' thickness, with friction.
     Vbd,
+    /// Implicit Euler solved by Newton's method: each iteration a global solve (conjugate
+    /// gradients) and a line search on the step's energy, within block descent's bounds
+    /// (docs/physics.md §4.2). Order 1; stable for any `dt`, damps; converges where block
+    /// descent cannot, on stiff and volumetric bodies.
+    Newton,
 }
 
 impl Integrator {
     /// All integrators, in the order of docs/physics.md §4.
-    pub const ALL: [Integrator; 6] = [
+    pub const ALL: [Integrator; 7] = [
         Self::Euler,
         Self::Symplectic,
         Self::Midpoint,
         Self::Rk4,
         Self::Implicit,
         Self::Vbd,
+        Self::Newton,
     ];
 
     /// The name used on the command line and in scene files.
@@ -123,6 +136,7 @@ impl Integrator {
             Self::Rk4 => "rk4",
             Self::Implicit => "implicit",
             Self::Vbd => "vbd",
+            Self::Newton => "newton",
         }
     }
 
@@ -131,17 +145,25 @@ impl Integrator {
     pub fn iteration_cap(self) -> Option<usize> {
         match self {
             Self::Vbd => Some(StopRule::VBD.iterations),
+            Self::Newton => Some(StopRule::NEWTON.iterations),
             Self::Implicit => Some(implicit::CG_MAX_ITERATIONS),
             _ => None,
         }
     }
 
     /// Whether a step takes energy out and nothing after it puts any back: implicit Euler
-    /// solved with its contacts inside the solve (block descent), so no contact phase moves
-    /// a particle out of a collider after the step. Such a run may not gain more than a
-    /// hundredth of its energy scale beyond the work done on it (docs/physics.md §7).
+    /// solved with its contacts inside the solve (block descent, Newton), so no contact
+    /// phase moves a particle out of a collider after the step. Such a run may not gain more
+    /// than a hundredth of its energy scale beyond the work done on it (docs/physics.md §7).
     pub fn dissipates(self) -> bool {
-        matches!(self, Self::Vbd)
+        self.solves_contacts()
+    }
+
+    /// Whether its contacts are inside its solve, bounded at the bodies' thickness (block
+    /// descent and Newton): no contact phase runs after its steps, and a moving collider or
+    /// keyed pins split a step into parts (docs/physics.md §4.1).
+    pub fn solves_contacts(self) -> bool {
+        matches!(self, Self::Vbd | Self::Newton)
     }
 
     /// Order of convergence on smooth problems.
@@ -150,7 +172,7 @@ impl Integrator {
             Self::Euler | Self::Symplectic => 1,
             Self::Midpoint => 2,
             Self::Rk4 => 4,
-            Self::Implicit | Self::Vbd => 1,
+            Self::Implicit | Self::Vbd | Self::Newton => 1,
         }
     }
 
@@ -162,8 +184,8 @@ impl Integrator {
             Self::Rk4 => 4,
             // One evaluation, then a linear solve of a few to a few hundred iterations.
             Self::Implicit => 1,
-            // A detection, then local solves: counted as one evaluation.
-            Self::Vbd => 1,
+            // A detection, then local (or global) solves: counted as one evaluation.
+            Self::Vbd | Self::Newton => 1,
         }
     }
 
@@ -179,6 +201,7 @@ impl Integrator {
             Self::Rk4 => rk4::STABILITY_RADIUS,
             Self::Implicit => implicit::STABILITY_RADIUS,
             Self::Vbd => vbd::STABILITY_RADIUS,
+            Self::Newton => newton::STABILITY_RADIUS,
         }
     }
 
@@ -204,6 +227,7 @@ impl Integrator {
             Self::Rk4 => rk4::step(model, particles, (t, dt), ws),
             Self::Implicit => implicit::step(model, particles, (t, dt), ws, held),
             Self::Vbd => vbd::step(model, particles, (t, dt), ws),
+            Self::Newton => newton::step(model, particles, (t, dt), ws),
         }
     }
 }
@@ -270,8 +294,11 @@ pub struct Workspace {
     pub(crate) vt: Vec<Vec3>,
     /// The implicit integrator's blocks and preconditioner.
     pub(crate) implicit: implicit::ImplicitBuffers,
-    /// The block-descent integrator's colouring, detection and buffers.
+    /// The block-descent integrator's colouring, detection and buffers (Newton's step
+    /// shares its detection, targets and counts).
     pub(crate) vbd: vbd::VbdBuffers,
+    /// Newton's system and conjugate-gradient vectors.
+    pub(crate) newton: newton::NewtonBuffers,
     /// The air forces' incidences and buffers.
     pub(crate) air: AirForces,
     /// The force loop's compilation, when not the detected one.
@@ -281,9 +308,10 @@ pub struct Workspace {
 }
 
 impl Workspace {
-    /// Conjugate-gradient iterations of the last implicit step (0 for other integrators).
+    /// Conjugate-gradient iterations of the last implicit step, or of the last Newton step
+    /// (all its iterations summed; 0 for other integrators).
     pub fn cg_iterations(&self) -> usize {
-        self.implicit.iterations
+        self.implicit.iterations + self.newton.cg_iterations
     }
 
     /// Iterations of the last block-descent step (0 for other integrators).
@@ -326,9 +354,18 @@ impl Workspace {
         self.vbd.times
     }
 
+    /// The rule block descent (or Newton, `newton`) ends its steps by.
+    pub fn stop_rule_of(&self, integrator: Integrator) -> StopRule {
+        self.stop.unwrap_or(if integrator == Integrator::Newton {
+            StopRule::NEWTON
+        } else {
+            StopRule::VBD
+        })
+    }
+
     /// The rule block descent ends its steps by.
     pub fn stop_rule(&self) -> StopRule {
-        self.stop.unwrap_or(StopRule::VBD)
+        self.stop_rule_of(Integrator::Vbd)
     }
 
     /// Lays out `model`'s springs and sizes the buffers `integrator` uses for `particles`

@@ -284,7 +284,7 @@ impl Simulation {
     /// [`Simulation::step`] on the current thread.
     fn step_here(&mut self) -> Result<(), Divergence> {
         let time = self.time();
-        let report = if self.integrator == Integrator::Vbd
+        let report = if self.integrator.solves_contacts()
             && (self.model.has_moving_colliders() || !self.model.pin_motions.is_empty())
         {
             self.step_swept(time)
@@ -305,7 +305,7 @@ impl Simulation {
         // Every scheme saves its start positions when the model has a contact phase.
         // Block descent keeps its contacts inside its own iterations.
         let moved = self.model.has_contact_phase()
-            && self.integrator != Integrator::Vbd
+            && !self.integrator.solves_contacts()
             && contact::phase(
                 &self.model,
                 &mut self.particles,
@@ -343,7 +343,7 @@ impl Simulation {
         if !self.crossings.watches(&self.model) {
             return;
         }
-        let vbd = self.integrator == Integrator::Vbd;
+        let vbd = self.integrator.solves_contacts();
         let mut moved = 0.0;
         if vbd {
             // Block descent's bounds keep still colliders out at any step.

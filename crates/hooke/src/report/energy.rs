@@ -73,7 +73,10 @@ fn run(name: &str, integrator: Integrator, window: f64) -> Result<EnergyRun> {
     let overrides = Overrides {
         integrator: Some(integrator),
         // The large-step integrators at the step they are for, not the explicit one's.
-        dt: matches!(integrator, Integrator::Implicit | Integrator::Vbd).then_some(LARGE_STEP),
+        dt: integrator
+            .stability_radius()
+            .is_infinite()
+            .then_some(LARGE_STEP),
         ..Overrides::default()
     };
     let mut scene = crate::source::build(name, &overrides)?;
@@ -137,7 +140,7 @@ pub(crate) fn runs(quick: bool, tick: &mut dyn FnMut()) -> Result<Vec<EnergyRun>
     for (name, make) in hooke_scene::builtin::BUILTINS {
         let moving = make().colliders.iter().any(|c| c.motion.is_some());
         for integrator in Integrator::ALL {
-            if moving && integrator == Integrator::Vbd {
+            if moving && integrator.solves_contacts() {
                 continue;
             }
             out.push(run(name, integrator, window(quick))?);

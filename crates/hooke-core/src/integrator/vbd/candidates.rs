@@ -24,7 +24,7 @@ use crate::particles::Vec3;
 use rayon::prelude::*;
 
 /// The skin of a build, as a share of the reach it serves.
-pub(super) const SKIN: f64 = 1.0;
+pub(in crate::integrator) const SKIN: f64 = 1.0;
 
 /// Candidates tested per parallel chunk.
 const CHUNK: usize = 4096;
@@ -32,7 +32,7 @@ const CHUNK: usize = 4096;
 /// One listed pair: its two primitives (a particle and a triangle, or two edges), the
 /// distance at its last exact test and its particles' travel summed then.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Candidate {
+pub(in crate::integrator) struct Candidate {
     a: u32,
     b: u32,
     distance: f64,
@@ -41,7 +41,7 @@ pub(super) struct Candidate {
 
 /// The list and the travel since its build.
 #[derive(Clone, Debug, Default)]
-pub(super) struct Candidates {
+pub(in crate::integrator) struct Candidates {
     /// The reach the list holds every pair within, at the build.
     built: f64,
     /// Whether a list was built for the current topology.
@@ -71,7 +71,7 @@ fn surface_mean(topo: &Topology, x: &[Vec3]) -> Vec3 {
 
 impl Candidates {
     /// Adds the motion since the last detection to each surface particle's travel.
-    pub(super) fn update(&mut self, topo: &Topology, x: &[Vec3], reach: f64) {
+    pub(in crate::integrator) fn update(&mut self, topo: &Topology, x: &[Vec3], reach: f64) {
         let mean = surface_mean(topo, x);
         if !self.valid || self.last.len() != x.len() || !reach.is_finite() {
             self.valid = false;
@@ -99,12 +99,12 @@ impl Candidates {
     }
 
     /// Whether the list may miss a pair within `reach` (see the module docs).
-    pub(super) fn stale(&self, reach: f64) -> bool {
+    pub(in crate::integrator) fn stale(&self, reach: f64) -> bool {
         !self.valid || 2.0 * self.most >= self.built - reach
     }
 
     /// Keeps `point_tri` and `edge_edge`, measured now, as every pair within `built`.
-    pub(super) fn rebuild(
+    pub(in crate::integrator) fn rebuild(
         &mut self,
         built: f64,
         point_tri: Vec<Candidate>,
@@ -123,7 +123,7 @@ impl Candidates {
     /// and `(edge, earlier edge, distance)`. A pair whose budget shows it beyond the reach
     /// is not measured; every other is, and its distance and travel kept.
     #[allow(clippy::type_complexity)]
-    pub(super) fn within(
+    pub(in crate::integrator) fn within(
         &mut self,
         topo: &Topology,
         x: &[Vec3],
@@ -198,7 +198,7 @@ fn check(
 /// Every point–triangle pair (a surface particle, a triangle not holding it) and edge–edge
 /// pair (sharing no particle; each unordered pair once) of the surfaces within `reach` at
 /// `x`, measured, through the grids' search.
-pub(super) fn search(
+pub(in crate::integrator) fn search(
     topo: &Topology,
     x: &[Vec3],
     reach: f64,

@@ -83,13 +83,13 @@ impl Clearance {
 
 /// The surfaces' primitives, fixed for a model.
 #[derive(Clone, Debug, Default)]
-pub(super) struct Topology {
+pub(in crate::integrator) struct Topology {
     built_for: usize,
     /// Active surfaces' triangles and edges, with their surface's index.
-    pub(super) triangles: Vec<([u32; 3], u16)>,
-    pub(super) edges: Vec<([u32; 2], u16)>,
+    pub(in crate::integrator) triangles: Vec<([u32; 3], u16)>,
+    pub(in crate::integrator) edges: Vec<([u32; 2], u16)>,
     /// Per particle: its active surface, or `u16::MAX`.
-    pub(super) surface: Vec<u16>,
+    pub(in crate::integrator) surface: Vec<u16>,
     /// Whether any surface pair (self or between bodies) can touch.
     self_pairs: bool,
     /// Per triangle: which of its edges (bits 0..3: ab, bc, ca) and corners (bits 3..6)
@@ -148,7 +148,7 @@ impl Topology {
 
 /// The result of a detection, and its buffers.
 #[derive(Clone, Debug, Default)]
-pub(super) struct Detection {
+pub(in crate::integrator) struct Detection {
     topology: Topology,
     triangle_grid: Grid,
     edge_grid: Grid,
@@ -157,24 +157,24 @@ pub(super) struct Detection {
     rest: Vec<Vec3>,
     /// Per particle: the collider surfaces it may reach before the next detection, each as
     /// its tangent plane at the detection.
-    pub(super) touches: Vec<Touches>,
+    pub(in crate::integrator) touches: Vec<Touches>,
     /// Per particle: the half-space colliders near it, which bound only the motion that
     /// closes its gap to them.
-    pub(super) halves: Vec<HalfSpaces>,
+    pub(in crate::integrator) halves: Vec<HalfSpaces>,
     /// Surface pairs and feature pairs within reach.
-    pub(super) pairs: Vec<Pair>,
+    pub(in crate::integrator) pairs: Vec<Pair>,
     /// Per free body of the graph: whether a surface pair joins it to another body (then
     /// it is left out of the coarse correction, docs/physics.md §4.1).
-    pub(super) touches_another: Vec<bool>,
+    pub(in crate::integrator) touches_another: Vec<bool>,
     /// Particle `i`'s pairs are `refs[start[i]..start[i + 1]]`.
     start: Vec<u32>,
     refs: Vec<u32>,
     /// The counting sort's write positions.
     cursor: Vec<u32>,
     /// Per particle: the centre offset (`u` or zero) and radius of the ball it stays in.
-    pub(super) shift: Vec3,
-    pub(super) shifted: Vec<bool>,
-    pub(super) bound: Vec<f64>,
+    pub(in crate::integrator) shift: Vec3,
+    pub(in crate::integrator) shifted: Vec<bool>,
+    pub(in crate::integrator) bound: Vec<f64>,
     /// Per particle, per triangle, per edge: distances found (capped at the reach).
     point_collider: Vec<Clearance>,
     triangle_collider: Vec<Clearance>,
@@ -194,7 +194,7 @@ pub(super) struct Detection {
     /// shared translation, `|c - u|` (`c` its keyed displacement); zero for the rest.
     excess: Vec<f64>,
     /// Per particle: its stiffness scale `m/dt² + Σ ks`.
-    pub(super) scale: Vec<f64>,
+    pub(in crate::integrator) scale: Vec<f64>,
 }
 
 /// `f` over fixed chunks of `0..n` in parallel, results concatenated in chunk order.
@@ -210,7 +210,7 @@ fn chunked<T: Send>(n: usize, f: impl Fn(Range<usize>) -> Vec<T> + Sync + Send) 
 }
 
 /// The box holding `points` (at least one).
-pub(super) fn bounds_of(points: &[&Vec3]) -> (Vec3, Vec3) {
+pub(in crate::integrator) fn bounds_of(points: &[&Vec3]) -> (Vec3, Vec3) {
     let mut lo = *points[0];
     let mut hi = *points[0];
     for p in &points[1..] {
@@ -221,18 +221,18 @@ pub(super) fn bounds_of(points: &[&Vec3]) -> (Vec3, Vec3) {
 }
 
 /// Whether point `p` lies in box `lo..hi` grown by `r`.
-pub(super) fn within(p: &Vec3, (lo, hi): &(Vec3, Vec3), r: f64) -> bool {
+pub(in crate::integrator) fn within(p: &Vec3, (lo, hi): &(Vec3, Vec3), r: f64) -> bool {
     (0..3).all(|k| p[k] >= lo[k] - r && p[k] <= hi[k] + r)
 }
 
 /// Whether boxes `a` and `b` come within `r` of each other.
-pub(super) fn boxes_within(a: &(Vec3, Vec3), b: &(Vec3, Vec3), r: f64) -> bool {
+pub(in crate::integrator) fn boxes_within(a: &(Vec3, Vec3), b: &(Vec3, Vec3), r: f64) -> bool {
     (0..3).all(|k| a.0[k] <= b.1[k] + r && b.0[k] <= a.1[k] + r)
 }
 
 /// Bins `boxes` into `grid` with cells as large as the largest box plus `reach`, so that
 /// everything within `reach` of a query lies in the 27 cells around it ([`by_cell`]).
-pub(super) fn bin(grid: &mut Grid, boxes: &[(Vec3, Vec3)], reach: f64) {
+pub(in crate::integrator) fn bin(grid: &mut Grid, boxes: &[(Vec3, Vec3)], reach: f64) {
     let extent = boxes
         .iter()
         .map(|(lo, hi)| (hi - lo).max())
@@ -244,7 +244,7 @@ pub(super) fn bin(grid: &mut Grid, boxes: &[(Vec3, Vec3)], reach: f64) {
 /// items of the 27 cells around that cell (every item whose low corner lies within one cell
 /// of the query's), gathered once per occupied cell. Results come in the order of (cell,
 /// query): fixed by the positions alone, never by threads.
-pub(super) fn by_cell<T: Send>(
+pub(in crate::integrator) fn by_cell<T: Send>(
     grid: &Grid,
     cells: &[Cell],
     test: impl Fn(usize, &[u32], &mut Vec<T>) + Sync + Send,
@@ -279,7 +279,7 @@ pub(super) fn by_cell<T: Send>(
 
 /// The normal stiffness and Coulomb coefficient a collider's response gives a contact with
 /// stiffness scale `scale`.
-pub(super) fn collider_law(response: &Response, scale: f64) -> (f64, f64) {
+pub(in crate::integrator) fn collider_law(response: &Response, scale: f64) -> (f64, f64) {
     match *response {
         Response::Penalty { kc, .. } => (kc, 0.0),
         Response::Restitution { friction, .. } => (CONTACT_STIFFNESS * scale, friction),
@@ -290,10 +290,16 @@ pub(super) fn collider_law(response: &Response, scale: f64) -> (f64, f64) {
 impl Detection {
     /// Particle `i`'s pairs.
     #[inline]
-    pub(super) fn pairs_of(&self, i: usize) -> impl Iterator<Item = &Pair> {
+    pub(in crate::integrator) fn pairs_of(&self, i: usize) -> impl Iterator<Item = &Pair> {
         self.refs[self.start[i] as usize..self.start[i + 1] as usize]
             .iter()
             .map(|&k| &self.pairs[k as usize])
+    }
+
+    /// The indices into [`Detection::pairs`] of particle `i`'s pairs.
+    #[inline]
+    pub(in crate::integrator) fn pair_indices(&self, i: usize) -> &[u32] {
+        &self.refs[self.start[i] as usize..self.start[i + 1] as usize]
     }
 
     /// Marks the graph's free bodies that a surface pair joins to another body: corrected
@@ -328,12 +334,12 @@ impl Detection {
     }
 
     /// Whether any pair was found.
-    pub(super) fn has_pairs(&self) -> bool {
+    pub(in crate::integrator) fn has_pairs(&self) -> bool {
         !self.pairs.is_empty()
     }
 
     /// Calls `f` with every particle that shares a pair with particle `i`.
-    pub(super) fn partners(&self, i: usize, f: &mut dyn FnMut(u32)) {
+    pub(in crate::integrator) fn partners(&self, i: usize, f: &mut dyn FnMut(u32)) {
         for pair in self.pairs_of(i) {
             for &j in &pair.ids {
                 if j != u32::MAX && j as usize != i {
@@ -345,19 +351,19 @@ impl Detection {
 
     /// Whether particle `i` may feel a contact before the next detection.
     #[inline]
-    pub(super) fn may_touch(&self, i: usize) -> bool {
+    pub(in crate::integrator) fn may_touch(&self, i: usize) -> bool {
         self.touches[i].count != 0 || self.start[i] != self.start[i + 1]
     }
 
     /// The thickness particle `i` keeps from colliders.
     #[inline]
-    pub(super) fn margin(&self, model: &Model, i: usize) -> f64 {
+    pub(in crate::integrator) fn margin(&self, model: &Model, i: usize) -> f64 {
         self.topology.margin(model, i)
     }
 
     /// Detects at positions `x` (the current iterate), with `y` the step's inertial targets
     /// (which set how far the search reaches and the shared translation `u`).
-    pub(super) fn detect(
+    pub(in crate::integrator) fn detect(
         &mut self,
         model: &Model,
         p: &Particles,
@@ -421,15 +427,18 @@ impl Detection {
                     continue;
                 }
                 let half = slot.shape.is_half_space();
+                // A penalty collider is a force field the course lets particles enter: it
+                // bounds nothing, and its surface is felt wherever the search reaches.
+                let force = slot.response.is_force();
                 slot.shape.contacts_within(&x[i], reach, &mut |c| {
                     let d = reach - c.depth;
                     // Inside already: no bound from it (staying is no crossing); its
                     // contact pushes the particle out.
                     let inside = d < 0.0;
-                    let felt = inside || d <= FELT * margin;
+                    let felt = force || inside || d <= FELT * margin;
                     // A half-space bounds only the motion along its normal.
-                    let kept = half && !inside && halves.keep(c.point, c.normal, d);
-                    if !inside && !kept {
+                    let kept = half && !force && !inside && halves.keep(c.point, c.normal, d);
+                    if !force && !inside && !kept {
                         clearance.see(d, felt);
                     }
                     if felt {

@@ -6,45 +6,45 @@ use crate::particles::Particles;
 
 /// One spring seen from one of its ends.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Neighbour {
+pub(in crate::integrator) struct Neighbour {
     /// The particle at the other end.
-    pub(super) other: u32,
-    pub(super) rest: f64,
-    pub(super) ks: f64,
-    pub(super) kd: f64,
+    pub(in crate::integrator) other: u32,
+    pub(in crate::integrator) rest: f64,
+    pub(in crate::integrator) ks: f64,
+    pub(in crate::integrator) kd: f64,
 }
 
 /// Per-particle spring lists and the colouring, built once per model.
 #[derive(Clone, Debug, Default)]
-pub(super) struct Graph {
+pub(in crate::integrator) struct Graph {
     /// The particle and spring counts it was built for.
     built_for: (usize, usize),
     /// Particle `i`'s neighbours are `neighbours[start[i]..start[i + 1]]`, in spring order.
     start: Vec<u32>,
     neighbours: Vec<Neighbour>,
     /// The free (unpinned) particles of each colour, in increasing index.
-    pub(super) colours: Vec<Vec<u32>>,
+    pub(in crate::integrator) colours: Vec<Vec<u32>>,
     /// Per particle: `m / dt²`-free stiffness scale, the sum of its springs' `ks`.
-    pub(super) stiffness: Vec<f64>,
+    pub(in crate::integrator) stiffness: Vec<f64>,
     /// Whether the colouring also separates the last detection's contact pairs.
-    pub(super) coloured_with_contacts: bool,
+    pub(in crate::integrator) coloured_with_contacts: bool,
     /// The bodies that may translate as a whole: the particles of each connected set of
     /// springs holding no pinned particle, in increasing index (the coarse correction's
     /// groups, docs/physics.md §4.1).
-    pub(super) free_bodies: Vec<Vec<u32>>,
+    pub(in crate::integrator) free_bodies: Vec<Vec<u32>>,
     /// Per particle: the index of its free body, or `u32::MAX`.
-    pub(super) body_of: Vec<u32>,
+    pub(in crate::integrator) body_of: Vec<u32>,
 }
 
 impl Graph {
     /// Whether it was built for `particles` particles and `springs` springs.
-    pub(super) fn fits(&self, particles: usize, springs: usize) -> bool {
+    pub(in crate::integrator) fn fits(&self, particles: usize, springs: usize) -> bool {
         self.built_for == (particles, springs) && !self.start.is_empty()
     }
 
     /// Builds the lists and a greedy colouring in particle order, which depends on the model
     /// alone (never on threads).
-    pub(super) fn new(model: &Model, p: &Particles) -> Self {
+    pub(in crate::integrator) fn new(model: &Model, p: &Particles) -> Self {
         let n = p.len();
         let mut count = vec![0u32; n + 1];
         for s in &model.springs {
@@ -100,7 +100,11 @@ impl Graph {
     /// Colours the free particles greedily in index order: each takes the lowest colour
     /// that none of its earlier spring neighbours, nor the earlier particles `contacts` names
     /// for it, has. Depends on the model and the contacts alone, never on threads.
-    pub(super) fn colour(&mut self, p: &Particles, contacts: impl Fn(usize, &mut dyn FnMut(u32))) {
+    pub(in crate::integrator) fn colour(
+        &mut self,
+        p: &Particles,
+        contacts: impl Fn(usize, &mut dyn FnMut(u32)),
+    ) {
         let n = p.len();
         let mut colour = vec![u32::MAX; n];
         for c in &mut self.colours {
@@ -137,9 +141,15 @@ impl Graph {
         self.colours.truncate(used);
     }
 
+    /// Where particle `i`'s springs start in the list of every particle's springs.
+    #[inline]
+    pub(in crate::integrator) fn first(&self, i: usize) -> usize {
+        self.start[i] as usize
+    }
+
     /// The springs of particle `i`.
     #[inline]
-    pub(super) fn of(&self, i: usize) -> &[Neighbour] {
+    pub(in crate::integrator) fn of(&self, i: usize) -> &[Neighbour] {
         &self.neighbours[self.start[i] as usize..self.start[i + 1] as usize]
     }
 }

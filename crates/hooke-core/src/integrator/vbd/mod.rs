@@ -22,10 +22,10 @@
 //!   `v = (x - x₀) / dt`.
 
 mod candidates;
-mod detect;
-mod graph;
-mod local;
-mod pairs;
+pub(in crate::integrator) mod detect;
+pub(in crate::integrator) mod graph;
+pub(in crate::integrator) mod local;
+pub(in crate::integrator) mod pairs;
 mod planes;
 pub(crate) mod swept;
 
@@ -39,7 +39,7 @@ use local::Local;
 use rayon::prelude::*;
 
 /// Block descent is implicit Euler: stable for every step.
-pub(super) const STABILITY_RADIUS: f64 = f64::INFINITY;
+pub(in crate::integrator) const STABILITY_RADIUS: f64 = f64::INFINITY;
 /// The share of the free particles that must wait at their bounds before an iteration
 /// detects again (besides the detection at every step's start).
 const DETECT_SHARE: f64 = 0.01;
@@ -51,14 +51,14 @@ const CHUNK: usize = 256;
 /// Buffers of the block-descent step, kept between steps.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct VbdBuffers {
-    graph: Graph,
-    detection: Detection,
+    pub(in crate::integrator) graph: Graph,
+    pub(in crate::integrator) detection: Detection,
     /// Inertial targets.
-    target: Vec<Vec3>,
+    pub(in crate::integrator) target: Vec<Vec3>,
     /// Per particle: `m v + dt f_ext`, its momentum after the step were it free.
-    momentum: Vec<Vec3>,
+    pub(in crate::integrator) momentum: Vec<Vec3>,
     /// Positions at the last detection.
-    detected: Vec<Vec3>,
+    pub(in crate::integrator) detected: Vec<Vec3>,
     /// One colour's new positions and whether each was clipped.
     next: Vec<(Vec3, bool)>,
     /// Velocities at the start of the last step (for the first guess).
@@ -87,7 +87,7 @@ pub(crate) struct VbdBuffers {
     pub(crate) times: crate::integrator::SolveTimes,
 }
 
-pub(super) fn step(
+pub(in crate::integrator) fn step(
     model: &Model,
     p: &mut Particles,
     (t, dt): (f64, f64),
@@ -96,79 +96,11 @@ pub(super) fn step(
     let mut clock = crate::integrator::Lap::start();
     let rule = ws.stop.unwrap_or(StopRule::VBD);
     let n = p.len();
-    ws.x0.copy_from_slice(&p.x);
-    let air = ws
-        .air
-        .evaluate(model.air.as_ref(), &model.aero, &p.x, &p.v, t);
+    prepare(model, p, (t, dt), ws, &mut clock);
     let b = &mut ws.vbd;
-    if !b.graph.fits(n, model.springs.len()) {
-        b.graph = Graph::new(model, p);
-    }
-    // Inertial targets `x + dt v + dt² f_ext/m`, and each particle's momentum after the
-    // step were it free, `m v + dt f_ext`.
-    let external = |i: usize| {
-        let mut f = model.gravity * p.mass[i];
-        if let Some(field) = &model.field {
-            f += field.sample(&p.x[i]);
-        }
-        if let Some(a) = air.get(i) {
-            f += a;
-        }
-        f
-    };
-    b.target.clear();
-    b.momentum.clear();
-    for i in 0..n {
-        let f = external(i);
-        b.momentum.push(p.v[i] * p.mass[i] + f * dt);
-        b.target.push(if p.is_pinned(i) {
-            p.x[i] + p.v[i] * dt
-        } else {
-            p.x[i] + p.v[i] * dt + f * (dt * dt / p.mass[i])
-        });
-    }
-    // The targets are the step's, not the solve's: their time is the rest's.
-    let _ = clock.lap();
-    b.detection
-        .detect(model, p, &b.graph, (&p.x, &b.target), dt);
-    // A keyframed pin moves at its velocity over the step (docs/physics.md §1.2): implicit
-    // Euler solves the free particles against where it ends, so its springs pull them along
-    // within the step, and it keeps that velocity (a still pin's target is where it is).
-    // The detection, at the step's start, counted that move in the bounds.
-    for ((x, target), inv_mass) in p.x.iter_mut().zip(&b.target).zip(&p.inv_mass) {
-        if *inv_mass == 0.0 {
-            *x = *target;
-        }
-    }
-    b.detected.clear();
-    b.detected.extend_from_slice(&p.x);
-    b.detections = 1;
-    // The first guess (after Chen et al. 2024's adaptive one): the inertial motion with as
-    // much of gravity as the particle showed last step (none for a cloth at rest on a table,
-    // all of it in free fall), clipped to the bounds of the step's detection.
-    let g = model.gravity.norm();
-    let fresh = b.previous.len() != n;
-    for i in 0..n {
-        if p.is_pinned(i) {
-            continue;
-        }
-        let share = if fresh || g == 0.0 {
-            1.0
-        } else {
-            let a = (p.v[i] - b.previous[i]) / dt;
-            (a.dot(&model.gravity) / (g * g)).clamp(0.0, 1.0)
-        };
-        let guess = p.x[i] + p.v[i] * dt + model.gravity * (share * dt * dt);
-        p.x[i] = clip(&b.detection, &b.detected, i, guess).0;
-    }
     recolour(&mut b.graph, &b.detection, p);
-    b.previous.clear();
-    b.previous.extend_from_slice(&p.v);
-    b.older.clear();
-    b.older.extend_from_slice(&p.x);
-    b.old.clear();
-    b.old.extend_from_slice(&p.x);
     b.times.detection += clock.lap();
+    let g = model.gravity.norm();
     let free = (0..n).filter(|&i| !p.is_pinned(i)).count();
     // Detect again when this many particles wait at their bounds (Chen et al. 2025 detect
     // again at 1 % of the vertices): fewer wait there until the next step.
@@ -290,6 +222,90 @@ pub(super) fn step(
     StepReport::SAVED
 }
 
+/// What block descent and Newton's step share before they iterate (docs/physics.md §4.1):
+/// the start positions, the inertial targets and free momenta, the detection at the step's
+/// start, the keyed pins put at their ends, and the first guess clipped to the bounds.
+pub(in crate::integrator) fn prepare(
+    model: &Model,
+    p: &mut Particles,
+    (t, dt): (f64, f64),
+    ws: &mut Workspace,
+    clock: &mut crate::integrator::Lap,
+) {
+    let n = p.len();
+    ws.x0.copy_from_slice(&p.x);
+    let air = ws
+        .air
+        .evaluate(model.air.as_ref(), &model.aero, &p.x, &p.v, t);
+    let b = &mut ws.vbd;
+    if !b.graph.fits(n, model.springs.len()) {
+        b.graph = Graph::new(model, p);
+    }
+    // Inertial targets `x + dt v + dt² f_ext/m`, and each particle's momentum after the
+    // step were it free, `m v + dt f_ext`.
+    let external = |i: usize| {
+        let mut f = model.gravity * p.mass[i];
+        if let Some(field) = &model.field {
+            f += field.sample(&p.x[i]);
+        }
+        if let Some(a) = air.get(i) {
+            f += a;
+        }
+        f
+    };
+    b.target.clear();
+    b.momentum.clear();
+    for i in 0..n {
+        let f = external(i);
+        b.momentum.push(p.v[i] * p.mass[i] + f * dt);
+        b.target.push(if p.is_pinned(i) {
+            p.x[i] + p.v[i] * dt
+        } else {
+            p.x[i] + p.v[i] * dt + f * (dt * dt / p.mass[i])
+        });
+    }
+    // The targets are the step's, not the solve's: their time is the rest's.
+    let _ = clock.lap();
+    b.detection
+        .detect(model, p, &b.graph, (&p.x, &b.target), dt);
+    // A keyframed pin moves at its velocity over the step (docs/physics.md §1.2): implicit
+    // Euler solves the free particles against where it ends, so its springs pull them along
+    // within the step, and it keeps that velocity (a still pin's target is where it is).
+    // The detection, at the step's start, counted that move in the bounds.
+    for ((x, target), inv_mass) in p.x.iter_mut().zip(&b.target).zip(&p.inv_mass) {
+        if *inv_mass == 0.0 {
+            *x = *target;
+        }
+    }
+    b.detected.clear();
+    b.detected.extend_from_slice(&p.x);
+    b.detections = 1;
+    // The first guess (after Chen et al. 2024's adaptive one): the inertial motion with as
+    // much of gravity as the particle showed last step (none for a cloth at rest on a table,
+    // all of it in free fall), clipped to the bounds of the step's detection.
+    let g = model.gravity.norm();
+    let fresh = b.previous.len() != n;
+    for i in 0..n {
+        if p.is_pinned(i) {
+            continue;
+        }
+        let share = if fresh || g == 0.0 {
+            1.0
+        } else {
+            let a = (p.v[i] - b.previous[i]) / dt;
+            (a.dot(&model.gravity) / (g * g)).clamp(0.0, 1.0)
+        };
+        let guess = p.x[i] + p.v[i] * dt + model.gravity * (share * dt * dt);
+        p.x[i] = clip(&b.detection, &b.detected, i, guess).0;
+    }
+    b.previous.clear();
+    b.previous.extend_from_slice(&p.v);
+    b.older.clear();
+    b.older.extend_from_slice(&p.x);
+    b.old.clear();
+    b.old.extend_from_slice(&p.x);
+}
+
 /// The coarse correction (a two-level scheme's coarsest level, after Tamstorf et al. 2015):
 /// each free body moves as a whole by the Newton step of its translation, `Δ = H⁻¹ F`
 /// with `F` the sum of its particles' forces and `H` of their Hessians, both without the
@@ -369,7 +385,13 @@ fn residual(local: &Local<'_>, p: &Particles, g: f64) -> f64 {
 /// collider, pin, attachment or drag), the leftover is spread as one velocity, which moves
 /// no particle relative to another (no crossing), and momentum is kept to round-off, as
 /// the other integrators keep it.
-fn keep_momentum(model: &Model, p: &mut Particles, start: &[Vec3], momentum: &[Vec3], dt: f64) {
+pub(in crate::integrator) fn keep_momentum(
+    model: &Model,
+    p: &mut Particles,
+    start: &[Vec3],
+    momentum: &[Vec3],
+    dt: f64,
+) {
     let closed = model.colliders.is_empty()
         && model.attachments.is_empty()
         && !model.has_drag()
@@ -404,7 +426,12 @@ fn recolour(graph: &mut Graph, detection: &Detection, p: &Particles) {
 
 /// `to` clipped to particle `i`'s ball, and whether it had to be.
 #[inline]
-fn clip(detection: &Detection, detected: &[Vec3], i: usize, to: Vec3) -> (Vec3, bool) {
+pub(in crate::integrator) fn clip(
+    detection: &Detection,
+    detected: &[Vec3],
+    i: usize,
+    to: Vec3,
+) -> (Vec3, bool) {
     let centre = if detection.shifted[i] {
         detected[i] + detection.shift
     } else {

@@ -6,7 +6,7 @@ use crate::particles::Vec3;
 
 /// What a pair's two sides are.
 #[derive(Clone, Copy, Debug)]
-pub(super) enum Sides {
+pub(in crate::integrator) enum Sides {
     /// Particle `ids[0]` against triangle `ids[1..4]`, which owns the features marked in
     /// its mask (see `Topology::owns` in `detect.rs`).
     PointTriangle(u8),
@@ -20,15 +20,15 @@ pub(super) enum Sides {
 
 /// A contact between two primitives, felt by the particles in `ids`.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Pair {
-    pub(super) sides: Sides,
-    pub(super) ids: [u32; 4],
+pub(in crate::integrator) struct Pair {
+    pub(in crate::integrator) sides: Sides,
+    pub(in crate::integrator) ids: [u32; 4],
     /// The gap kept, metres.
-    pub(super) h: f64,
+    pub(in crate::integrator) h: f64,
     /// Normal stiffness, N/m.
-    pub(super) k: f64,
+    pub(in crate::integrator) k: f64,
     /// Coulomb coefficient (infinite: stick; zero: none).
-    pub(super) mu: f64,
+    pub(in crate::integrator) mu: f64,
 }
 
 /// The closest points of a pair at `x`: weights `w` on its particles such that
@@ -37,7 +37,7 @@ pub(super) struct Pair {
 /// sharing it, and two edges nearest at an end are a point against a triangle: such a
 /// contact counts once (the owning triangle's, the point–triangle pair's), so that a
 /// particle over a fold of a mesh does not feel it six times.
-pub(super) fn stencil(pair: &Pair, x: &[Vec3]) -> ([f64; 4], Vec3, usize, bool) {
+pub(in crate::integrator) fn stencil(pair: &Pair, x: &[Vec3]) -> ([f64; 4], Vec3, usize, bool) {
     let p = |k: usize| &x[pair.ids[k] as usize];
     match pair.sides {
         Sides::PointTriangle(owns) => {
@@ -72,7 +72,7 @@ pub(super) fn stencil(pair: &Pair, x: &[Vec3]) -> ([f64; 4], Vec3, usize, bool) 
 }
 
 /// The length of a pair's gap at `x`.
-pub(super) fn stencil_distance(pair: &Pair, x: &[Vec3]) -> f64 {
+pub(in crate::integrator) fn stencil_distance(pair: &Pair, x: &[Vec3]) -> f64 {
     let (w, anchor, len, _) = stencil(pair, x);
     let mut g = -anchor;
     for k in 0..len {

@@ -7,10 +7,10 @@ use crate::particles::Vec3;
 /// faces and within the bound's reach of exact for curved ones, at the cost of a dot
 /// product instead of a collider query.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Plane {
-    pub(super) collider: u16,
-    pub(super) point: Vec3,
-    pub(super) normal: Vec3,
+pub(in crate::integrator) struct Plane {
+    pub(in crate::integrator) collider: u16,
+    pub(in crate::integrator) point: Vec3,
+    pub(in crate::integrator) normal: Vec3,
 }
 
 /// Planes a particle keeps at most (a box's corner and a table's edge need three).
@@ -18,8 +18,8 @@ const TOUCHES: usize = 4;
 
 /// The collider planes one particle may touch, nearest kept when there are more.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Touches {
-    pub(super) count: u8,
+pub(in crate::integrator) struct Touches {
+    pub(in crate::integrator) count: u8,
     planes: [Plane; TOUCHES],
     gaps: [f64; TOUCHES],
 }
@@ -41,12 +41,12 @@ impl Default for Touches {
 
 impl Touches {
     /// The planes.
-    pub(super) fn planes(&self) -> &[Plane] {
+    pub(in crate::integrator) fn planes(&self) -> &[Plane] {
         &self.planes[..self.count as usize]
     }
 
     /// Keeps `plane` at gap `d` if there is room or it is nearer than the farthest kept.
-    pub(super) fn keep(&mut self, plane: Plane, d: f64) {
+    pub(in crate::integrator) fn keep(&mut self, plane: Plane, d: f64) {
         let k = if (self.count as usize) < TOUCHES {
             self.count += 1;
             self.count as usize - 1
@@ -78,14 +78,14 @@ const HALF_SPACES: usize = 2;
 /// `normal · (x - point)` above `(1 - γ)` of that gap: sliding along a plane closes no gap,
 /// so only the motion along its normal is bounded (docs/physics.md §4.1).
 #[derive(Clone, Copy, Debug, Default)]
-pub(super) struct HalfSpaces {
+pub(in crate::integrator) struct HalfSpaces {
     count: u8,
     planes: [(Vec3, Vec3, f64); HALF_SPACES],
 }
 
 impl HalfSpaces {
     /// Keeps the plane through `point` with unit `normal` at gap `d`; `false` when full.
-    pub(super) fn keep(&mut self, point: Vec3, normal: Vec3, d: f64) -> bool {
+    pub(in crate::integrator) fn keep(&mut self, point: Vec3, normal: Vec3, d: f64) -> bool {
         if self.count as usize == HALF_SPACES {
             return false;
         }
@@ -95,7 +95,7 @@ impl HalfSpaces {
     }
 
     /// `(point, normal, gap)` of each plane kept.
-    pub(super) fn iter(&self) -> impl Iterator<Item = &(Vec3, Vec3, f64)> {
+    pub(in crate::integrator) fn iter(&self) -> impl Iterator<Item = &(Vec3, Vec3, f64)> {
         self.planes[..self.count as usize].iter()
     }
 }
