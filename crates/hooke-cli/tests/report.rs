@@ -75,7 +75,11 @@ fn the_report_page_loads_in_chromium_with_every_image_and_no_console_error() {
         serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
     assert_eq!(json["failures"].as_array().unwrap().len(), 0);
     let sweeps = json["convergence"].as_array().unwrap();
-    assert_eq!(sweeps.len(), 6, "one sweep per integrator");
+    assert_eq!(
+        sweeps.len(),
+        hooke_core::Integrator::ALL.len(),
+        "one sweep per integrator"
+    );
     for s in sweeps {
         let (slope, expected) = (
             s["slope"].as_f64().unwrap(),

@@ -72,6 +72,9 @@ pub(crate) struct NewtonBuffers {
     held: Vec<bool>,
     /// The springs' part of the system, factored: the preconditioner.
     factor: factor::Factor,
+    /// The energy's partial sums, and the contact couplings handed to the factor.
+    parts: Vec<f64>,
+    couplings: Vec<(usize, usize, Sym3)>,
     /// Conjugate-gradient iterations of the last step, all Newton iterations summed.
     pub(crate) cg_iterations: usize,
 }
@@ -125,7 +128,7 @@ pub(super) fn step(
         nb.cg_iterations += solve(&local, nb, model.springs.len());
         b.times.sweeps += clock.lap();
         // Backtracking on the energy, every trial point clipped to its bounds.
-        let before = local.energy(&p.x, &p.x, &nb.pinned);
+        let before = local.energy(&p.x, &p.x, &nb.pinned, &mut nb.parts);
 
         let mut alpha = 1.0;
         let mut held = 0;
@@ -146,7 +149,9 @@ pub(super) fn step(
                     to
                 };
             }
-            if halving == HALVINGS || local.energy(&nb.trial, &p.x, &nb.pinned) <= before {
+            if halving == HALVINGS
+                || local.energy(&nb.trial, &p.x, &nb.pinned, &mut nb.parts) <= before
+            {
                 break;
             }
             alpha *= 0.5;
@@ -335,13 +340,15 @@ fn solve(local: &Local<'_>, nb: &mut NewtonBuffers, springs: usize) -> usize {
         return done;
     }
     {
-        let pairs = couplings(local, nb);
+        let mut pairs = std::mem::take(&mut nb.couplings);
+        couplings(local, nb, &mut pairs);
         nb.factor.factor(
             local.graph,
             (&nb.diagonal, &nb.springs),
             (&nb.pinned, &pairs),
             springs,
         );
+        nb.couplings = pairs;
     }
     let (more, _) = conjugate_gradients(local, nb, norm, CG_MAX_ITERATIONS - done, nb.factor.ready);
 
@@ -353,9 +360,9 @@ fn solve(local: &Local<'_>, nb: &mut NewtonBuffers, springs: usize) -> usize {
 /// (which takes those its pattern holds). A side's blocks with its own diagonal blocks
 /// are a positive semi-definite whole; the blocks across a contact, which the pattern holds
 /// only by chance, are left to the gradients, so that what is factored stays definite.
-fn couplings(local: &Local<'_>, nb: &NewtonBuffers) -> Vec<(usize, usize, Sym3)> {
+fn couplings(local: &Local<'_>, nb: &NewtonBuffers, out: &mut Vec<(usize, usize, Sym3)>) {
     use super::vbd::pairs::Sides;
-    let mut out = Vec::new();
+    out.clear();
     for (k, pair) in local.detection.pairs.iter().enumerate() {
         let Some((w, len, m)) = &nb.pairs[k] else {
             continue;
@@ -374,7 +381,6 @@ fn couplings(local: &Local<'_>, nb: &NewtonBuffers) -> Vec<(usize, usize, Sym3)>
             }
         }
     }
-    out
 }
 
 /// Conjugate gradients on `H d = f` from the current `d` (its residual recomputed),

@@ -242,16 +242,25 @@ impl Local<'_> {
     /// friction), so that minus its gradient at `x = base` is exactly every particle's
     /// [`Local::row`] force and a line search from `base` measures what the forces ask.
     /// Sums run over fixed chunks added in order, so any thread count gives the same bits.
-    pub(in crate::integrator) fn energy(&self, x: &[Vec3], base: &[Vec3], pinned: &[bool]) -> f64 {
+    /// `parts` holds the chunks' partial sums (kept by the caller, so that a line search
+    /// allocates nothing).
+    pub(in crate::integrator) fn energy(
+        &self,
+        x: &[Vec3],
+        base: &[Vec3],
+        pinned: &[bool],
+        parts: &mut Vec<f64>,
+    ) -> f64 {
         use rayon::prelude::*;
         const CHUNK: usize = 1024;
         let dt = self.dt;
         let model = self.model;
-        let chunked = |n: usize, f: &(dyn Fn(usize) -> f64 + Sync)| -> f64 {
-            let parts: Vec<f64> = (0..n.div_ceil(CHUNK))
-                .into_par_iter()
-                .map(|c| (c * CHUNK..((c + 1) * CHUNK).min(n)).map(f).sum::<f64>())
-                .collect();
+        let mut chunked = |n: usize, f: &(dyn Fn(usize) -> f64 + Sync)| -> f64 {
+            parts.clear();
+            parts.resize(n.div_ceil(CHUNK), 0.0);
+            parts.par_iter_mut().enumerate().for_each(|(c, part)| {
+                *part = (c * CHUNK..((c + 1) * CHUNK).min(n)).map(f).sum::<f64>();
+            });
             parts.iter().sum()
         };
         let particle = |i: usize| {
