@@ -66,6 +66,10 @@ class Simulation:
         pitch: float = 22.0,
         zoom: float = 1.0,
         supersample: int = 2,
+        distance: Optional[float] = None,
+        color: str = "none",
+        range: Optional[tuple[float, float]] = None,
+        shadows: bool = True,
     ) -> npt.NDArray[np.uint8]:
         """(height, width, 3) RGB picture of the state now."""
     def export(self, path: str, format: Optional[str] = None, body: Optional[str] = None) -> str:

@@ -371,8 +371,12 @@ impl Simulation {
     /// The scene as it stands now drawn by Hooke's rasterizer: an `(height, width, 3)`
     /// uint8 array. `style` is `solid`, `springs` or `both`; `yaw` and `pitch` in degrees
     /// turn the camera about the scene; `zoom` multiplies the framing distance (below 1
-    /// moves closer); `supersample` is 1 to 4 samples per pixel along each axis.
-    #[pyo3(signature = (width = 800, height = 600, style = "solid", yaw = 30.0, pitch = 22.0, zoom = 1.0, supersample = 2))]
+    /// moves closer); `supersample` is 1 to 4 samples per pixel along each axis;
+    /// `distance` places the camera that many metres from the framed centre; `color` is
+    /// `"none"`, `"strain"` (%), `"speed"` (m/s) or `"gap"` (m), drawn with a legend over
+    /// `range` (`(lo, hi)`, default the frame's own rounded up); `shadows` casts the key
+    /// light's shadows.
+    #[pyo3(signature = (width = 800, height = 600, style = "solid", yaw = 30.0, pitch = 22.0, zoom = 1.0, supersample = 2, distance = None, color = "none", range = None, shadows = true))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -384,12 +388,38 @@ impl Simulation {
         pitch: f64,
         zoom: f64,
         supersample: i64,
+        distance: Option<f64>,
+        color: &str,
+        range: Option<(f64, f64)>,
+        shadows: bool,
     ) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
         let supersample = whole(supersample, "supersample", 1, 4)? as u32;
         let width = whole(width, "width", 1, u64::from(u32::MAX))? as u32;
         let height = whole(height, "height", 1, u64::from(u32::MAX))? as u32;
-        let view = View::checked((width, height), style, (yaw, pitch), zoom, supersample)
+        let mut view = View::checked((width, height), style, (yaw, pitch), zoom, supersample)
             .map_err(error)?;
+        view.color = hooke::quantity::ColorBy::from_name(color).ok_or_else(|| {
+            HookeError::new_err(format!(
+                "color: expected none, strain, speed or gap, found '{color}'"
+            ))
+        })?;
+        if let Some(d) = distance
+            && !(d.is_finite() && (1e-3..=1e6).contains(&d))
+        {
+            return Err(HookeError::new_err(format!(
+                "distance: expected metres from 0.001 to 1e6, found {d}"
+            )));
+        }
+        if let Some((lo, hi)) = range
+            && !(lo.is_finite() && hi.is_finite() && lo < hi)
+        {
+            return Err(HookeError::new_err(format!(
+                "range: expected (lo, hi) with finite lo below hi, found ({lo}, {hi})"
+            )));
+        }
+        view.distance = distance;
+        view.range = range;
+        view.shadows = shadows;
         let inner = self.lock()?;
         let (scene, pool) = (&inner.scene, inner.pool.as_ref());
         let rgb = py.detach(|| {

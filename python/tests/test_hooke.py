@@ -218,6 +218,23 @@ def test_render_gives_an_rgb_picture_of_the_asked_size():
         sim.render(pitch=90.0)
 
 
+def test_render_colours_by_a_quantity_with_its_legend_and_places_the_camera():
+    sim = hooke.load("hanging-cloth")
+    sim.advance(0.5)
+    plain = sim.render(width=320, height=240, supersample=1)
+    strain = sim.render(width=320, height=240, supersample=1, color="strain", range=(-5.0, 5.0))
+    assert strain.shape == plain.shape and (strain != plain).any()
+    # The legend's bar at the right edge: its top is coolwarm's red end.
+    right = strain[:, 240:, :].reshape(-1, 3).astype(int)
+    assert ((right[:, 0] - right[:, 2]) > 100).any(), "a red end of the bar"
+    near = sim.render(width=320, height=240, supersample=1, distance=1.0, shadows=False)
+    assert (near != plain).any()
+    with pytest.raises(hooke.HookeError, match="color"):
+        sim.render(color="heat")
+    with pytest.raises(hooke.HookeError, match="range"):
+        sim.render(color="speed", range=(2.0, 1.0))
+
+
 def test_export_writes_what_the_command_writes(tmp_path):
     import pxr.Usd  # usd-core: cargo xtask test installs it
     sim = hooke.load("chain", steps=400, every=40)
@@ -329,6 +346,6 @@ def test_report_writes_the_page_and_its_numbers(tmp_path):
     assert "Every check passed" in text
     numbers = json.loads((tmp_path / "report" / "report.json").read_text())
     orders = {s["integrator"]: (s["slope"], s["expected"]) for s in numbers["convergence"]}
-    assert set(orders) == {"euler", "symplectic", "midpoint", "rk4", "implicit", "vbd"}
+    assert set(orders) == {"euler", "symplectic", "midpoint", "rk4", "implicit", "vbd", "newton"}
     for name, (slope, expected) in orders.items():
         assert abs(slope - expected) <= 0.1, (name, slope, expected)

@@ -3,6 +3,7 @@
 
 use hooke::draw::{DEFAULT_YAW_PITCH, Style};
 use hooke::image_out::{PITCH, SIDE, View, YAW, ZOOM, in_range};
+use hooke::quantity::ColorBy;
 use image::RgbaImage;
 
 /// Camera placement options shared by the commands that draw.
@@ -26,18 +27,100 @@ pub struct ViewArgs {
     /// Samples per pixel along each axis, 1 to 4 (2 = 4× anti-aliasing, 1 = off).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=4))]
     pub supersample: u32,
+    /// Place the camera: AZIMUTH,ELEVATION,DISTANCE (degrees about the vertical, degrees
+    /// above the horizontal, metres from the framed centre), or a named view: front, back,
+    /// left, right, top or three-quarter (the default framing). Replaces --yaw and --pitch.
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_camera)]
+    pub camera: Option<Placement>,
+    /// Colour the bodies by a quantity, with a legend: strain (each structural spring's
+    /// (length − rest)/rest averaged to its particles, %), speed (m/s) or gap (to the
+    /// nearest collider, m, the contact thickness marked).
+    #[arg(long, value_enum, default_value_t = ColorBy::None)]
+    pub color: ColorBy,
+    /// The colour map's range as LO,HI in the quantity's unit (default: the frame's own,
+    /// rounded up; an animation takes its range from a first pass over the run).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_range)]
+    pub range: Option<(f64, f64)>,
+    /// Draw without shadows.
+    #[arg(long)]
+    pub no_shadows: bool,
+}
+
+/// Where `--camera` puts the camera: yaw, pitch (degrees) and the distance (metres; `None`:
+/// the framing's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    yaw: f64,
+    pitch: f64,
+    distance: Option<f64>,
+}
+
+/// Parses `--camera`: `AZIMUTH,ELEVATION,DISTANCE` or a named view.
+fn parse_camera(s: &str) -> Result<Placement, String> {
+    let named = |yaw: f64, pitch: f64| {
+        Ok(Placement {
+            yaw,
+            pitch,
+            distance: None,
+        })
+    };
+    match s.trim().to_ascii_lowercase().as_str() {
+        "front" => return named(0.0, 10.0),
+        "back" => return named(180.0, 10.0),
+        "right" => return named(90.0, 10.0),
+        "left" => return named(-90.0, 10.0),
+        "top" => return named(0.0, 89.0),
+        "three-quarter" => return named(DEFAULT_YAW_PITCH.0, DEFAULT_YAW_PITCH.1),
+        _ => {}
+    }
+    let parts: Vec<&str> = s.split(',').collect();
+    let [az, el, d] = parts[..] else {
+        return Err(format!(
+            "expected AZIMUTH,ELEVATION,DISTANCE (degrees, degrees, metres) such as \
+             30,20,4 or a view (front, back, left, right, top, three-quarter), found '{s}'"
+        ));
+    };
+    Ok(Placement {
+        yaw: parse_within(az, YAW.0, YAW.1, "an azimuth in degrees")?,
+        pitch: parse_within(el, PITCH.0, PITCH.1, "an elevation in degrees")?,
+        distance: Some(parse_within(d, 1e-3, 1e6, "a distance in metres")?),
+    })
+}
+
+/// Parses `--range LO,HI`: two finite numbers, LO below HI.
+fn parse_range(s: &str) -> Result<(f64, f64), String> {
+    let (lo, hi) = s
+        .split_once(',')
+        .ok_or_else(|| format!("expected LO,HI such as -5,5, found '{s}'"))?;
+    let number = |v: &str| {
+        v.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite() && x.abs() <= 1e12)
+            .ok_or_else(|| format!("expected LO,HI with numbers within ±1e12, found '{s}'"))
+    };
+    let (lo, hi) = (number(lo)?, number(hi)?);
+    if lo >= hi {
+        return Err(format!("expected LO below HI, found '{s}'"));
+    }
+    Ok((lo, hi))
 }
 
 impl ViewArgs {
     /// The library's view these options describe.
     pub fn view(&self) -> View {
+        let placed = self.camera;
         View {
             size: self.size,
             style: self.style,
-            yaw: self.yaw,
-            pitch: self.pitch,
+            yaw: placed.map_or(self.yaw, |p| p.yaw),
+            pitch: placed.map_or(self.pitch, |p| p.pitch),
             zoom: self.zoom,
             supersample: self.supersample,
+            distance: placed.and_then(|p| p.distance),
+            shadows: !self.no_shadows,
+            color: self.color,
+            range: self.range,
         }
     }
 }

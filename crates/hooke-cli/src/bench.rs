@@ -298,7 +298,12 @@ struct RenderFigures {
     height: u32,
     samples_per_pixel: u32,
     threads: usize,
+    /// With shadows (the default).
     render_ms: f64,
+    /// The same frame without shadows, timed in the same loop.
+    render_without_shadows_ms: f64,
+    /// `render_ms / render_without_shadows_ms`.
+    shadow_cost: f64,
     png_encode_ms: f64,
 }
 
@@ -519,7 +524,7 @@ fn scene_steps(
     let sim = &mut scene.simulation;
     use_kernel(sim, kernel)?;
     sim.measure_residuals(residual);
-    let times_before = sim.workspace().solve_times();
+    let times_before: hooke_core::SolveTimes = sim.workspace().solve_times();
     let from_start = sim.integrator() == Integrator::Implicit || sim.integrator().solves_contacts();
     let steps = match steps {
         Some(n) => n,
@@ -717,11 +722,20 @@ fn renders(
         // As an animation renders: one renderer, its buffers reused from frame to frame.
         let mut renderer = Renderer::default();
         let mut times = Vec::new();
+        let mut plain = Vec::new();
         let mut pixels = Vec::new();
+        let unshadowed = RenderOptions {
+            shadows: false,
+            ..options
+        };
+        // Interleaved, so that both see the same load on a shared machine.
         for _ in 0..repeat {
             let started = Instant::now();
             pixels = renderer.render(&list, &camera, &options);
             times.push(started.elapsed().as_secs_f64() * 1e3);
+            let started = Instant::now();
+            renderer.render(&list, &camera, &unshadowed);
+            plain.push(started.elapsed().as_secs_f64() * 1e3);
         }
         let image = RgbaImage::from_raw(width, height, pixels).context("image size")?;
         if let Some(dir) = save {
@@ -744,20 +758,24 @@ fn renders(
             height,
             samples_per_pixel: options.supersample * options.supersample,
             threads: rayon::current_num_threads(),
-            render_ms: median(times),
+            render_ms: median(times.clone()),
+            render_without_shadows_ms: median(plain.clone()),
+            shadow_cost: median(times) / median(plain),
             png_encode_ms: median(encode),
         };
         if json {
             println!("{}", serde_json::to_string(&figures)?);
         } else {
             println!(
-                "{:<12} {:>8} triangles at {width}x{height}, {}x AA, {}: render {:.1} ms, \
-                 PNG encode {:.1} ms (median of {repeat})",
+                "{:<12} {:>8} triangles at {width}x{height}, {}x AA, {}: render {:.1} ms \
+                 ({:.1} ms without shadows: {:.2}x), PNG encode {:.1} ms (median of {repeat})",
                 figures.scene,
                 figures.triangles,
                 figures.samples_per_pixel,
                 threads(figures.threads),
                 figures.render_ms,
+                figures.render_without_shadows_ms,
+                figures.shadow_cost,
                 figures.png_encode_ms
             );
         }

@@ -113,9 +113,18 @@ fn animate(
 ) -> Result<PathBuf> {
     let mut scene = source::build(name, &Overrides::default())?;
     scene.every = hooke::driver::steps_for(&scene, interval).max(1);
+    let range = match view.range {
+        None if view.color != hooke::quantity::ColorBy::None => {
+            let mut first = source::build(name, &Overrides::default())?;
+            first.every = scene.every;
+            Some(hooke::frames::animation_range(first, view.color))
+        }
+        range => range,
+    };
     let small = View {
         size: (view.size.0 / 2, view.size.1 / 2),
         supersample: 1,
+        range,
         ..view.clone()
     };
     let path = out.join(animation_name(name));

@@ -8,6 +8,7 @@ use hooke::frames::Frames;
 use hooke::interrupt::{self, is_interrupt};
 use hooke::output::claims::Claims;
 use hooke::output::{check_output_file, check_output_folder};
+use hooke::quantity::ColorBy;
 use hooke::trajectory::TrajectoryWriter;
 use hooke::{Sink, record, source};
 use hooke_core::Num;
@@ -59,6 +60,24 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         claims.file("--summary", Path::new("-"));
     }
     claims.check()?;
+    let mut view = args.view.view();
+    let animated = args.gif.is_some() || args.frames.is_some();
+    if animated && view.color != ColorBy::None && view.range.is_none() {
+        eprintln!(
+            "--color {}: a first pass over the run fixes the colour range of every frame \
+             (--range LO,HI skips it)",
+            view.color.title()
+        );
+        let first = source::build(&args.scene, &overrides)?;
+        let range = hooke::frames::animation_range(first, view.color);
+        eprintln!(
+            "--color: {} from {} to {}",
+            view.color.title(),
+            hooke_render::short(range.0),
+            hooke_render::short(range.1)
+        );
+        view.range = Some(range);
+    }
     let mut scene = source::build_prepared(source, &args.scene)?;
     warn_if_unstable(&scene);
     warn_if_tunnelling(&scene);
@@ -85,7 +104,7 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
     if let Some(frames) = Frames::new(
         args.frames.clone(),
         args.gif.clone(),
-        args.view.view(),
+        view,
         every as f64 * dt,
     )? {
         sinks.push(Box::new(frames));

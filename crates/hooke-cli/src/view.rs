@@ -6,7 +6,7 @@
 //! real time rather than freezing the window), or by a fixed `--clock` of simulated time,
 //! then the scene is drawn and the overlay written on top.
 
-use crate::draw::{DEFAULT_YAW_PITCH, Style, draw_with, frame_camera};
+use crate::draw::{DEFAULT_YAW_PITCH, Style, draw_tinted, frame_camera};
 use crate::source;
 use anyhow::{Context, Result};
 use font8x8::UnicodeFonts;
@@ -65,7 +65,7 @@ fn parse_clock(s: &str) -> Result<f64, String> {
 }
 
 const HELP: [&str; 2] = [
-    "TAB scene  R replay  drag rotate  SHIFT+drag/wheel/Z/X zoom  right-drag grab",
+    "TAB scene  R replay  drag rotate  SHIFT+drag/wheel/Z/X zoom  right-drag grab  G shadows  C colour",
     "P pause  V solid/springs  S/H/B struct/shear/bend  W wind  E camera  SPACE shot  ESC quit",
 ];
 
@@ -104,6 +104,10 @@ struct Viewer {
     scene: Scene,
     camera: Camera,
     home: Camera,
+    /// The quantity the bodies are coloured by (C cycles none, strain, speed, gap).
+    color: hooke::quantity::ColorBy,
+    /// Whether the key light casts shadows (G toggles).
+    shadows: bool,
     paused: bool,
     style: Style,
     /// The spring families shown in the springs style (s / h / b toggle them).
@@ -141,6 +145,8 @@ impl Viewer {
             camera,
             home: camera,
             paused: false,
+            shadows: true,
+            color: hooke::quantity::ColorBy::None,
             style: Style::Solid,
             families: Families::ALL,
             windless: None,
@@ -232,6 +238,7 @@ impl Viewer {
             width: size.0,
             height: size.1,
             supersample,
+            shadows: self.shadows,
             ..RenderOptions::default()
         }
     }
@@ -405,6 +412,16 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
                 Key::Tab => viewer.switch((viewer.current + 1) % viewer.scenes.len())?,
                 Key::R => viewer.replay()?,
                 Key::P => viewer.paused = !viewer.paused,
+                Key::G => viewer.shadows = !viewer.shadows,
+                Key::C => {
+                    use hooke::quantity::ColorBy;
+                    viewer.color = match viewer.color {
+                        ColorBy::None => ColorBy::Strain,
+                        ColorBy::Strain => ColorBy::Speed,
+                        ColorBy::Speed => ColorBy::Gap,
+                        ColorBy::Gap => ColorBy::None,
+                    };
+                }
                 Key::V => {
                     viewer.style = match viewer.style {
                         Style::Solid => Style::Springs,
@@ -453,8 +470,28 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
         pool.install(|| viewer.simulate(wall, args.clock.is_some()));
         let t1 = Instant::now();
         let pixels = pool.install(|| {
-            let list = draw_with(&viewer.scene, viewer.style, |k| viewer.show(k));
-            renderer.render(&list, &viewer.camera, &options)
+            // A quantity's colours each frame on its own range (rounded up), with its legend.
+            let by = viewer.color;
+            let shown = by.values(&viewer.scene).map(|values| {
+                let range = by.default_range(&values);
+                (by.colors(&values, range), range)
+            });
+            let tint = shown.as_ref().map(|(colors, _)| colors.as_slice());
+            let list = draw_tinted(&viewer.scene, viewer.style, |k| viewer.show(k), tint);
+            let options = RenderOptions {
+                ambient: if shown.is_some() {
+                    0.7
+                } else {
+                    options.ambient
+                },
+                ..options
+            };
+            let mut pixels = renderer.render(&list, &viewer.camera, &options);
+            if let Some((_, range)) = shown {
+                by.legend(&viewer.scene, range)
+                    .draw(&mut pixels, options.width, options.height);
+            }
+            pixels
         });
         for (o, p) in buffer.iter_mut().zip(pixels.chunks_exact(4)) {
             *o = (p[0] as u32) << 16 | (p[1] as u32) << 8 | p[2] as u32;

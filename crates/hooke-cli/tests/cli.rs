@@ -587,3 +587,76 @@ fn check_warns_of_a_collider_that_moves_too_fast_for_its_thickness() {
         stderr(&out)
     );
 }
+
+/// Issue 57: `--color`, `--range` and `--camera` on stills and animations. An animation
+/// coloured by a quantity takes one range for all its frames from a first pass (said on
+/// stderr), so that frame colours compare; bad values are refused with what was expected.
+#[test]
+fn pictures_take_a_colour_map_a_range_and_a_placed_camera() {
+    let dir = scratch("colour");
+    let out = hooke(
+        &[
+            "run",
+            "chain",
+            "--duration",
+            "0.5",
+            "--every",
+            "500",
+            "--gif",
+            "s.gif",
+            "--size",
+            "96x72",
+            "--color",
+            "speed",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let said = stderr(&out);
+    assert!(
+        said.contains("a first pass over the run fixes the colour range")
+            && said.contains("--color: speed (m/s) from 0 to"),
+        "{said}"
+    );
+    let out = hooke(
+        &[
+            "render", "chain", "--at", "0.2", "-o", "c.png", "--size", "160x120", "--color",
+            "speed", "--range", "0,10", "--camera", "90,10,3",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(
+        image::open(dir.join("c.png"))
+            .unwrap()
+            .to_rgba8()
+            .dimensions(),
+        (160, 120)
+    );
+    for (flag, value, expected) in [
+        ("--camera", "1,2", "expected AZIMUTH,ELEVATION,DISTANCE"),
+        (
+            "--camera",
+            "0,95,3",
+            "an elevation in degrees from -89 to 89",
+        ),
+        ("--camera", "0,10,-1", "a distance in metres"),
+        ("--range", "5,1", "expected LO below HI"),
+        ("--range", "0,inf", "within ±1e12"),
+        (
+            "--color",
+            "heat",
+            "possible values: none, strain, speed, gap",
+        ),
+    ] {
+        let out = hooke(&["render", "chain", "-o", "x.png", flag, value], &dir);
+        assert!(!out.status.success());
+        assert!(
+            stderr(&out).contains(expected),
+            "{flag} {value}: {}",
+            stderr(&out)
+        );
+        assert!(!dir.join("x.png").exists());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -44,6 +44,15 @@ impl Camera {
             ) * self.distance
     }
 
+    /// The key light's direction (unit, from the scene towards the light): from the upper
+    /// front-left as the camera sees it, so that every view is lit alike and its shadows
+    /// fall down and to the right, behind the bodies.
+    pub fn key_light(&self) -> Vector3<f64> {
+        let forward = (self.target - self.eye()).normalize();
+        let right = forward.cross(&Vector3::y()).normalize();
+        (Vector3::y() * 1.2 - right * 0.5 - forward * 0.6).normalize()
+    }
+
     /// Near clipping distance: primitives closer than this are not drawn.
     pub fn near(&self) -> f64 {
         self.distance * 0.01

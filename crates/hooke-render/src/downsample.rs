@@ -5,6 +5,7 @@ use crate::draw_list::{DrawList, Rgb};
 use crate::options::RenderOptions;
 use crate::setup::{LineSetup, PointSetup, Rect, TriSetup};
 use crate::shading::Shading;
+use crate::shadow::ShadowMap;
 use crate::tile::{EMPTY, Samples};
 use nalgebra::Vector3;
 
@@ -18,34 +19,68 @@ pub(crate) struct Downsampler<'a> {
     pub lines: &'a [Option<LineSetup>],
     pub points: &'a [Option<PointSetup>],
     pub shading: Shading,
+    /// The key light's shadow map, when shadows are drawn.
+    pub shadow: Option<ShadowMap>,
     pub options: &'a RenderOptions,
     /// Samples per pixel along each axis.
     pub supersample: u32,
+}
+
+/// A lit material of one pixel: its colour, summed normal, sample count and summed shares
+/// of the key and ambient light.
+type Material = (Rgb, Vector3<f64>, u32, (f32, f32));
+
+/// A triangle's colour: one, or one per corner to interpolate.
+enum Corners {
+    One(Rgb),
+    Three([Rgb; 3]),
 }
 
 /// What a primitive shows at one point.
 enum Surface {
     /// An unlit colour: background and lines.
     Flat(Rgb),
-    /// A base colour lit with a normal.
-    Lit(Vector3<f64>, Rgb),
+    /// A base colour lit with a normal, and the shares of the key light and of the ambient
+    /// light it receives.
+    Lit(Vector3<f64>, Rgb, (f32, f32)),
 }
 
 impl Downsampler<'_> {
-    /// What primitive `id` shows at the sample-space point `p`.
-    fn surface(&self, id: u32, p: (f64, f64)) -> Surface {
+    /// What primitive `id` shows at the sample-space point `p`. `shadow` is the share of
+    /// the key light found for another primitive of the same pixel, if any: within a pixel
+    /// the shadow map's filter (five texels wide) does not change, and a pixel where a
+    /// cloth's small triangles meet looks it up once rather than once per triangle.
+    fn surface(&self, id: u32, p: (f64, f64), shadow: &mut Option<(f32, f32)>) -> Surface {
         let id = id as usize;
         let (tris, lines) = (self.tris.len(), self.lines.len());
         if id < tris {
             let Some(s) = &self.tris[id] else {
                 return Surface::Flat([0.0; 3]);
             };
-            if s.tiny {
-                return Surface::Lit(s.normal, s.color);
-            }
-            let (n, color) = self.corner_normals(s.src as usize);
-            let w = s.weights(p);
-            Surface::Lit(n[0] * w[0] + n[1] * w[1] + n[2] * w[2], color)
+            let (n, q, colors) = self.corners(s.src as usize);
+            let w = if s.tiny { [1.0 / 3.0; 3] } else { s.weights(p) };
+            let color = match colors {
+                Corners::One(c) => c,
+                Corners::Three(c) => {
+                    let w = w.map(|w| w as f32);
+                    [0, 1, 2].map(|k| c[0][k] * w[0] + c[1][k] * w[1] + c[2][k] * w[2])
+                }
+            };
+            let normal = if s.tiny {
+                s.normal
+            } else {
+                n[0] * w[0] + n[1] * w[1] + n[2] * w[2]
+            };
+            let light = match (&self.shadow, *shadow) {
+                (None, _) => (1.0, 1.0),
+                (Some(_), Some(found)) => found,
+                (Some(map), None) => {
+                    let found = map.light(&(q[0] * w[0] + q[1] * w[1] + q[2] * w[2]), &normal);
+                    *shadow = Some(found);
+                    found
+                }
+            };
+            Surface::Lit(normal, color, light)
         } else if id < tris + lines {
             Surface::Flat(self.lines[id - tris].map_or([0.0; 3], |l| l.color))
         } else {
@@ -56,23 +91,34 @@ impl Downsampler<'_> {
             let r2 = (u * u + v * v).min(1.0);
             let n = self.shading.right * u + self.shading.up * v
                 - self.shading.forward * (1.0 - r2).sqrt();
-            Surface::Lit(n, s.color)
+            Surface::Lit(n, s.color, (1.0, 1.0))
         }
     }
 
-    /// The corner normals and colour of set-up triangle `id`: a mesh's, or after the
-    /// meshes' the list's own. Only triangles that were set up are asked for, and set-up
-    /// checked their corners.
-    fn corner_normals(&self, id: usize) -> ([Vector3<f64>; 3], Rgb) {
+    /// The corner normals, corner positions and colours of set-up triangle `id`: a
+    /// mesh's, or after the meshes' the list's own. Only triangles that were set up are
+    /// asked for, and set-up checked their corners.
+    fn corners(&self, id: usize) -> ([Vector3<f64>; 3], [Vector3<f64>; 3], Corners) {
         let meshes_end = self.mesh_start[self.mesh_start.len() - 1];
         if id < meshes_end {
             let m = self.mesh_start.partition_point(|&start| start <= id) - 1;
             let mesh = &self.list.meshes[m];
             let corners = mesh.triangles[id - self.mesh_start[m]];
-            (corners.map(|c| mesh.normals[c as usize]), mesh.color)
+            let colors = if mesh.colors.is_empty() {
+                Corners::One(mesh.color)
+            } else {
+                Corners::Three(
+                    corners.map(|c| mesh.colors.get(c as usize).copied().unwrap_or(mesh.color)),
+                )
+            };
+            (
+                corners.map(|c| mesh.normals[c as usize]),
+                corners.map(|c| mesh.positions[c as usize]),
+                colors,
+            )
         } else {
             let t = &self.list.triangles[id - meshes_end];
-            (t.n, t.color)
+            (t.n, t.p, Corners::One(t.color))
         }
     }
 
@@ -116,7 +162,7 @@ impl Downsampler<'_> {
         // or `materials` entries are read), as clearing 16 materials per edge pixel cost a
         // tenth of a cloth-256 frame.
         let mut ids = [(0u32, 0u32); 16];
-        let mut lit: [(Rgb, Vector3<f64>, u32); 16] = [([0.0; 3], Vector3::zeros(), 0); 16];
+        let mut lit: [Material; 16] = [([0.0; 3], Vector3::zeros(), 0, (0.0, 0.0)); 16];
         for (y, pixels) in (0..h).zip(out.chunks_exact_mut((w * 4) as usize)) {
             let background = self.background(py0 + y);
             let row = s.index(s.area.x0, s.area.y0 + y * ss);
@@ -142,9 +188,9 @@ impl Downsampler<'_> {
                 let c = if distinct == 1 && ids[0].0 == EMPTY {
                     background
                 } else if distinct == 1 {
-                    match self.surface(ids[0].0, centre) {
+                    match self.surface(ids[0].0, centre, &mut None) {
                         Surface::Flat(c) => c,
-                        Surface::Lit(n, c) => self.shading.shade(n, c),
+                        Surface::Lit(n, c, light) => self.shading.shade(n, c, light),
                     }
                 } else {
                     // Samples of one base colour are lit once with their summed normals:
@@ -152,11 +198,12 @@ impl Downsampler<'_> {
                     // per material rather than once per triangle, and looks the same.
                     let mut sum = [0.0f32; 3];
                     let mut materials = 0;
+                    let mut shadow = None;
                     for &(id, count) in &ids[..distinct] {
                         let surface = if id == EMPTY {
                             Surface::Flat(background)
                         } else {
-                            self.surface(id, centre)
+                            self.surface(id, centre, &mut shadow)
                         };
                         match surface {
                             Surface::Flat(c) => {
@@ -164,22 +211,31 @@ impl Downsampler<'_> {
                                     sum[k] += c[k] * count as f32;
                                 }
                             }
-                            Surface::Lit(n, c) => {
+                            Surface::Lit(n, c, light) => {
                                 match lit[..materials].iter_mut().find(|m| m.0 == c) {
                                     Some(m) => {
                                         m.1 += n * count as f64;
                                         m.2 += count;
+                                        m.3.0 += light.0 * count as f32;
+                                        m.3.1 += light.1 * count as f32;
                                     }
                                     None => {
-                                        lit[materials] = (c, n * count as f64, count);
+                                        let k = count as f32;
+                                        lit[materials] = (
+                                            c,
+                                            n * count as f64,
+                                            count,
+                                            (light.0 * k, light.1 * k),
+                                        );
                                         materials += 1;
                                     }
                                 }
                             }
                         }
                     }
-                    for (c, n, count) in &lit[..materials] {
-                        let c = self.shading.shade(*n, *c);
+                    for (c, n, count, light) in &lit[..materials] {
+                        let k = *count as f32;
+                        let c = self.shading.shade(*n, *c, (light.0 / k, light.1 / k));
                         for k in 0..3 {
                             sum[k] += c[k] * *count as f32;
                         }

@@ -19,8 +19,8 @@ pub struct Triangle {
 /// A smooth-shaded triangle mesh whose triangles share corners by index: each corner is
 /// projected once per frame however many triangles hold it, and the list stores a position
 /// and a normal per corner instead of three of each per triangle (for a cloth grid, a fifth
-/// of the bytes of the same surface as [`Triangle`]s). Drawn exactly as the [`Triangle`]s
-/// it expands to ([`Mesh::triangle`]).
+/// of the bytes of the same surface as [`Triangle`]s). Without per-corner colours, drawn
+/// exactly as the [`Triangle`]s it expands to ([`Mesh::triangle`]).
 ///
 /// ```
 /// use hooke_render::{DrawList, Mesh};
@@ -32,6 +32,7 @@ pub struct Triangle {
 ///     positions,
 ///     triangles: vec![[0, 1, 2], [0, 2, 3]],
 ///     color: [0.2, 0.45, 0.8],
+///     colors: Vec::new(),
 /// };
 /// assert_eq!(mesh.triangle(1).unwrap().p[2], Vector3::y());
 /// let mut list = DrawList::default();
@@ -49,6 +50,9 @@ pub struct Mesh {
     pub triangles: Vec<[u32; 3]>,
     /// Base colour of the whole mesh.
     pub color: Rgb,
+    /// A colour per corner, interpolated across each triangle (a quantity's colour map);
+    /// empty: the whole mesh is `color`.
+    pub colors: Vec<Rgb>,
 }
 
 impl Mesh {

@@ -2,7 +2,8 @@
 //!
 //! World-space meshes, triangles, lines and points plus a [`Camera`] in, RGBA pixels out. No
 //! physics, no files: the CLI turns particles, springs and colliders into a [`DrawList`] and
-//! encodes the pixels. Two-sided Lambert + ambient + a little specular lighting, a z-buffer,
+//! encodes the pixels. Two-sided Lambert + ambient + a little specular lighting, shadows
+//! from the key light (a shadow map with percentage-closer filtering), a z-buffer,
 //! 4× supersampling by default, tiles rendered in parallel with one writer per pixel,
 //! so the same frame gives the same pixels on any number of threads.
 //!
@@ -22,15 +23,20 @@
 
 mod bins;
 mod camera;
+mod colormap;
 mod downsample;
 mod draw_list;
+mod legend;
 mod options;
 mod raster;
 mod setup;
 mod shading;
+mod shadow;
 mod tile;
 
 pub use camera::Camera;
+pub use colormap::ColorMap;
 pub use draw_list::{DrawList, Line, Mesh, Point, Rgb, Triangle};
+pub use legend::{Legend, short};
 pub use options::RenderOptions;
 pub use raster::{Renderer, render};

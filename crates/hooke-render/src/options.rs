@@ -13,6 +13,12 @@ pub struct RenderOptions {
     pub supersample: u32,
     /// Background at the top and bottom of the image.
     pub background: [Rgb; 2],
+    /// Whether the key light casts shadows (from every triangle, onto every triangle).
+    pub shadows: bool,
+    /// The share of a surface's colour it shows unlit (the rest comes from the key light):
+    /// 0.35 for pictures, more where the colours carry a quantity and must read on the
+    /// side away from the light.
+    pub ambient: f32,
 }
 
 impl Default for RenderOptions {
@@ -22,6 +28,8 @@ impl Default for RenderOptions {
             height: 600,
             supersample: 2,
             background: [[0.80, 0.86, 0.93], [0.97, 0.97, 0.98]],
+            shadows: true,
+            ambient: 0.35,
         }
     }
 }

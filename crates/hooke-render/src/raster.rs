@@ -17,6 +17,7 @@ use crate::draw_list::DrawList;
 use crate::options::RenderOptions;
 use crate::setup::{Frame, LineSetup, PointSetup, Projected, Rect, TriSetup};
 use crate::shading::Shading;
+use crate::shadow::ShadowMap;
 use crate::tile::Samples;
 use rayon::prelude::*;
 
@@ -113,7 +114,7 @@ impl Renderer {
                 |k, &[a, b, c]| {
                     let p = [corner(a)?, corner(b)?, corner(c)?];
                     let n = [normal(a)?, normal(b)?, normal(c)?];
-                    TriSetup::projected(&frame, p, &n, mesh.color, (start + k) as u32)
+                    TriSetup::projected(&frame, p, &n, (start + k) as u32)
                 },
                 |t| t.rect,
             );
@@ -149,7 +150,12 @@ impl Renderer {
             tris: &self.tris,
             lines: &self.lines,
             points: &self.points,
-            shading: Shading::new(camera),
+            shading: Shading::new(camera, options.ambient),
+            shadow: if options.shadows {
+                ShadowMap::new(list, camera.key_light())
+            } else {
+                None
+            },
             options,
             supersample,
         };
@@ -270,6 +276,7 @@ mod tests {
             normals,
             triangles,
             color: [0.05, 0.05, 0.9],
+            colors: Vec::new(),
         }
     }
 

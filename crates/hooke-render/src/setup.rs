@@ -125,7 +125,6 @@ pub(crate) struct TriSetup {
     /// hundreds of megabytes per triangle (measured: 14 % of a 2-million-triangle frame),
     /// from here a read of what the tile's scan conversion just touched.
     pub normal: Vector3<f64>,
-    pub color: Rgb,
 }
 
 /// The edge function of `a → b` at `p`: twice the signed area of `(a, b, p)`.
@@ -141,7 +140,7 @@ impl TriSetup {
             frame.project(&t.p[1])?,
             frame.project(&t.p[2])?,
         ];
-        Self::projected(frame, p, &t.n, t.color, src)
+        Self::projected(frame, p, &t.n, src)
     }
 
     /// A triangle from its corners already projected (a mesh's, projected once per frame)
@@ -151,7 +150,6 @@ impl TriSetup {
         frame: &Frame,
         p: [Projected; 3],
         n: &[Vector3<f64>; 3],
-        color: Rgb,
         src: u32,
     ) -> Option<Self> {
         if p.iter().any(|q| q.x.abs() > GUARD || q.y.abs() > GUARD) {
@@ -193,7 +191,6 @@ impl TriSetup {
             tiny: rect.x1 - rect.x0 <= 2 && rect.y1 - rect.y0 <= 2,
             rect,
             normal: (n[0] + n[1] + n[2]) * (1.0 / 3.0),
-            color,
         })
     }
 

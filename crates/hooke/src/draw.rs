@@ -50,10 +50,10 @@ fn spring_color(kind: SpringKind) -> Rgb {
 }
 
 /// Adds a `rows × cols` sheet of particles (`index(r, c)`) as a smooth-shaded mesh, two
-/// triangles per grid square.
+/// triangles per grid square; coloured per particle by `tint` when given.
 fn sheet(
     list: &mut DrawList,
-    x: &[Vec3],
+    (x, tint): (&[Vec3], Option<&[Rgb]>),
     rows: usize,
     cols: usize,
     index: impl Fn(usize, usize) -> usize,
@@ -86,11 +86,17 @@ fn sheet(
             triangles.push([corner(r, c), corner(r + 1, c + 1), corner(r, c + 1)]);
         }
     }
+    let colors = tint.map_or_else(Vec::new, |tint| {
+        (0..rows * cols)
+            .map(|k| tint[index(k / cols, k % cols)])
+            .collect()
+    });
     list.meshes.push(Mesh {
         positions,
         normals,
         triangles,
         color,
+        colors,
     });
 }
 
@@ -201,31 +207,48 @@ pub fn draw(scene: &Scene, style: Style) -> DrawList {
 /// [`draw`], showing only the springs of the kinds `show` accepts (the viewer's s / h / b
 /// toggles); chains' strings and lone coils are always drawn.
 pub fn draw_with(scene: &Scene, style: Style, show: impl Fn(SpringKind) -> bool) -> DrawList {
+    draw_tinted(scene, style, show, None)
+}
+
+/// [`draw_with`], the bodies' surfaces and beads coloured per particle by `tint` (a
+/// quantity's colour map, [`crate::quantity::ColorBy`]) when given.
+pub fn draw_tinted(
+    scene: &Scene,
+    style: Style,
+    show: impl Fn(SpringKind) -> bool,
+    tint: Option<&[Rgb]>,
+) -> DrawList {
     let mut list = DrawList::default();
     let sim = &scene.simulation;
     let x = &sim.particles().x;
+    let tint = tint.filter(|t| t.len() == x.len());
+    let xs = (x.as_slice(), tint);
     let surfaces = style != Style::Springs;
     for body in &scene.bodies {
         let s = body.range.start;
         match body.topology {
             Topology::Grid([a, b]) if surfaces => {
-                sheet(&mut list, x, a, b, |r, c| s + r * b + c, CLOTH)
+                sheet(&mut list, xs, a, b, |r, c| s + r * b + c, CLOTH)
             }
             Topology::Lattice([a, b, c]) if surfaces => {
                 let idx = move |i: usize, j: usize, k: usize| s + (i * b + j) * c + k;
-                sheet(&mut list, x, a, b, |i, j| idx(i, j, 0), JELLY);
-                sheet(&mut list, x, a, b, |i, j| idx(i, j, c - 1), JELLY);
-                sheet(&mut list, x, a, c, |i, k| idx(i, 0, k), JELLY);
-                sheet(&mut list, x, a, c, |i, k| idx(i, b - 1, k), JELLY);
-                sheet(&mut list, x, b, c, |j, k| idx(0, j, k), JELLY);
-                sheet(&mut list, x, b, c, |j, k| idx(a - 1, j, k), JELLY);
+                sheet(&mut list, xs, a, b, |i, j| idx(i, j, 0), JELLY);
+                sheet(&mut list, xs, a, b, |i, j| idx(i, j, c - 1), JELLY);
+                sheet(&mut list, xs, a, c, |i, k| idx(i, 0, k), JELLY);
+                sheet(&mut list, xs, a, c, |i, k| idx(i, b - 1, k), JELLY);
+                sheet(&mut list, xs, b, c, |j, k| idx(0, j, k), JELLY);
+                sheet(&mut list, xs, b, c, |j, k| idx(a - 1, j, k), JELLY);
             }
             Topology::Chain | Topology::Points => {
                 for i in body.range.clone() {
                     let pinned = sim.particles().is_pinned(i);
                     list.points.push(Point {
                         p: x[i],
-                        color: if pinned { PIN } else { BEAD },
+                        color: match tint {
+                            Some(t) => t[i],
+                            None if pinned => PIN,
+                            None => BEAD,
+                        },
                         radius: if pinned { 5.0 } else { 6.0 },
                     });
                 }

@@ -4,8 +4,36 @@
 use crate::error::Result;
 use crate::image_out::{GifWriter, View, write_png_named};
 use crate::output::{frame_name, prepare_frame_folder};
+use crate::quantity::ColorBy;
 use hooke_scene::Scene;
 use std::path::PathBuf;
+
+/// The range an animation of `scene` shows quantity `by` with, so that its colours compare
+/// from frame to frame: a first pass runs the scene to its end (it is deterministic: the
+/// second pass is the same run) and takes the largest magnitude over its frames, rounded
+/// up as a still's is ([`ColorBy::default_range`]). A run that stops early (diverges, or
+/// is interrupted) gives the range of the frames it reached.
+pub fn animation_range(mut scene: Scene, by: ColorBy) -> (f64, f64) {
+    let every = scene.every.max(1);
+    let largest = |scene: &Scene| {
+        by.values(scene)
+            .unwrap_or_default()
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+    };
+    let mut top = largest(&scene);
+    let mut done = 0;
+    while done < scene.steps {
+        let n = every.min(scene.steps - done);
+        if crate::driver::advance(&mut scene, n).is_err() {
+            break;
+        }
+        done += n;
+        top = top.max(largest(&scene));
+    }
+    by.default_range(&[top])
+}
 
 /// Writes frames of a run as numbered PNGs and optionally a GIF, each as it comes.
 pub struct Frames {

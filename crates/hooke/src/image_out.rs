@@ -1,9 +1,10 @@
 //! Rendering scenes to PNG stills and GIF animations, written atomically; a GIF is encoded
 //! frame by frame as a run produces them, so its memory does not grow with its length.
 
-use crate::draw::{Style, draw, frame_camera};
+use crate::draw::{Style, draw_tinted, frame_camera};
 use crate::error::{Context, Result};
 use crate::output::{OutputFile, write_atomic, write_named};
+use crate::quantity::ColorBy;
 use hooke_render::{Camera, RenderOptions, render};
 use hooke_scene::Scene;
 use image::{ImageFormat, RgbaImage};
@@ -25,6 +26,16 @@ pub struct View {
     pub zoom: f64,
     /// Samples per pixel along each axis, 1 to 4 (2 = 4× anti-aliasing, 1 = off).
     pub supersample: u32,
+    /// The camera's distance from the framed centre, metres (`None`: the framing's, times
+    /// `zoom`).
+    pub distance: Option<f64>,
+    /// Whether the key light casts shadows.
+    pub shadows: bool,
+    /// The quantity the bodies are coloured by, with a legend.
+    pub color: ColorBy,
+    /// The colour map's range, in the quantity's unit (`None`: each frame's own, rounded
+    /// up; an animation fixes it for all its frames).
+    pub range: Option<(f64, f64)>,
 }
 
 impl Default for View {
@@ -37,6 +48,10 @@ impl Default for View {
             pitch: crate::draw::DEFAULT_YAW_PITCH.1,
             zoom: 1.0,
             supersample: 2,
+            distance: None,
+            shadows: true,
+            color: ColorBy::None,
+            range: None,
         }
     }
 }
@@ -110,25 +125,56 @@ impl View {
             pitch: within("pitch", pitch, PITCH, "an elevation in degrees")?,
             zoom: within("zoom", zoom, ZOOM, "a zoom factor")?,
             supersample,
+            ..Self::default()
         })
     }
 
     /// The camera for the scene's current state.
     pub fn camera(&self, scene: &Scene) -> Camera {
         let mut camera = frame_camera(scene, self.yaw, self.pitch);
+        if let Some(d) = self.distance {
+            camera.distance = d;
+        }
         camera.distance *= self.zoom;
         camera
     }
 
-    /// Renders the scene's current state to RGBA pixels.
+    /// The quantity's values on the scene now and the range they are shown with (the
+    /// view's, or their own rounded up); `None` without a quantity.
+    pub fn quantity(&self, scene: &Scene) -> Option<(Vec<f64>, (f64, f64))> {
+        let values = self.color.values(scene)?;
+        let range = self
+            .range
+            .unwrap_or_else(|| self.color.default_range(&values));
+        Some((values, range))
+    }
+
+    /// Renders the scene's current state to RGBA pixels, with the quantity's legend.
     pub fn pixels(&self, scene: &Scene, camera: &Camera) -> RgbaImage {
         let options = RenderOptions {
             width: self.size.0,
             height: self.size.1,
             supersample: self.supersample,
+            shadows: self.shadows,
+            // A quantity's colours read on the side away from the light too.
+            ambient: if self.color == ColorBy::None {
+                0.35
+            } else {
+                0.7
+            },
             ..RenderOptions::default()
         };
-        let pixels = render(&draw(scene, self.style), camera, &options);
+        let shown = self
+            .quantity(scene)
+            .map(|(values, range)| (self.color.colors(&values, range), range));
+        let tint = shown.as_ref().map(|(colors, _)| colors.as_slice());
+        let list = draw_tinted(scene, self.style, |_| true, tint);
+        let mut pixels = render(&list, camera, &options);
+        if let Some((_, range)) = shown {
+            self.color
+                .legend(scene, range)
+                .draw(&mut pixels, self.size.0, self.size.1);
+        }
         RgbaImage::from_raw(self.size.0, self.size.1, pixels)
             .expect("renderer returns width × height pixels")
     }

@@ -47,6 +47,7 @@ pub mod interrupt;
 pub mod memory;
 pub mod output;
 pub mod progress;
+pub mod quantity;
 #[cfg(feature = "report")]
 pub mod report;
 mod sink;

@@ -44,7 +44,7 @@ pub(crate) fn energy_file(name: &str) -> String {
     format!("energy-{name}.svg")
 }
 
-/// Scene `name`'s picture of `kind` (`still`, `golden`, `diff`).
+/// Scene `name`'s picture of `kind` (`still`, `golden`, `diff`, `strain`).
 pub(crate) fn scene_file(name: &str, kind: &str) -> String {
     format!("scene-{name}-{kind}.png")
 }
@@ -64,7 +64,7 @@ fn names(scenes: &[&str]) -> Vec<String> {
             .map(|(n, _)| energy_file(n)),
     );
     for name in scenes {
-        out.extend(["still", "golden", "diff"].map(|k| scene_file(name, k)));
+        out.extend(["still", "golden", "diff", "strain"].map(|k| scene_file(name, k)));
     }
     out
 }

@@ -274,6 +274,16 @@ fn scenes(h: &mut String, r: &Report) -> Result<()> {
              <figure><img src=\"{}\" alt=\"{} difference\"><figcaption>{} pixels differ</figcaption></figure></div>",
             s.name, s.still, s.name, s.golden, s.name, s.diff, s.name, s.differing_pixels
         )?;
+        if let Some(strain) = &s.strain {
+            writeln!(
+                h,
+                "<div class=triple><figure><img src=\"{}\" alt=\"{} strain\"><figcaption>\
+                 strain: largest {:.2} %; a column of the cloth hanging from one structural \
+                 spring stretches it {:.2} % (pinned corners hold more than a column)\
+                 </figcaption></figure></div>",
+                strain.file, s.name, strain.largest, strain.weight
+            )?;
+        }
     }
     Ok(())
 }

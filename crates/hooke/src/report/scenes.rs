@@ -8,6 +8,7 @@ use super::pixels::compare;
 use super::references::References;
 use crate::Result;
 use crate::image_out::View;
+use crate::quantity::ColorBy;
 use crate::stills::{still_steps, still_view};
 use hooke_core::Vec3;
 use hooke_core::contact::proximity::point_triangle;
@@ -39,6 +40,51 @@ pub(crate) struct SceneCheck {
     pub(crate) still: String,
     pub(crate) golden: String,
     pub(crate) diff: String,
+    /// A cloth scene's still coloured by strain, its largest strain (%) and what a column of
+    /// its cloth hanging from one structural spring stretches that spring by (%).
+    pub(crate) strain: Option<StrainPicture>,
+}
+
+/// A cloth scene's strain picture and figures.
+#[derive(Serialize)]
+pub(crate) struct StrainPicture {
+    pub(crate) file: String,
+    pub(crate) largest: f64,
+    pub(crate) weight: f64,
+}
+
+/// What the weight of a column of the cloth stretches the structural spring it hangs from
+/// by, in percent: `(n − 1) m g / (ks L)` for the longest column of `n` particles of mass
+/// `m` on springs of stiffness `ks` and rest length `L` (the mean over the structural
+/// springs). The scale of the stretch the cloth's own weight gives, where a pinned corner
+/// carries more (it holds more than one column).
+fn weight_strain(scene: &Scene) -> Option<f64> {
+    let model = scene.simulation.model();
+    let p = scene.simulation.particles();
+    let g = model.gravity.norm();
+    let mut best: Option<f64> = None;
+    for body in &scene.bodies {
+        let hooke_scene::Topology::Grid([a, b]) = body.topology else {
+            continue;
+        };
+        let springs: Vec<_> = model
+            .springs
+            .iter()
+            .filter(|s| {
+                s.kind == hooke_core::SpringKind::Structural && body.range.contains(&(s.i as usize))
+            })
+            .collect();
+        if springs.is_empty() {
+            continue;
+        }
+        let ks = springs.iter().map(|s| s.ks).sum::<f64>() / springs.len() as f64;
+        let rest = springs.iter().map(|s| s.rest).sum::<f64>() / springs.len() as f64;
+        let mass = p.mass[body.range.clone()].iter().sum::<f64>() / body.range.len() as f64;
+        let n = a.max(b) as f64;
+        let e = (n - 1.0) * mass * g / (ks * rest) * 100.0;
+        best = Some(best.map_or(e, |m: f64| m.max(e)));
+    }
+    best
 }
 
 /// The cloth's triangles now, with their corners.
@@ -160,6 +206,34 @@ fn check(name: &str, golden: &[u8], files: &mut Pending) -> Result<SceneCheck> {
         let bytes = crate::image_out::png_bytes(Path::new(&file(kind)), image)?;
         files.add(file(kind), bytes);
     }
+    let strain = match weight_strain(&scene) {
+        Some(weight) => {
+            let view = View {
+                color: ColorBy::Strain,
+                ..view.clone()
+            };
+            let picture = view.pixels(&scene, &view.camera(&scene));
+            let bytes = crate::image_out::png_bytes(Path::new(&file("strain")), &picture)?;
+            files.add(file("strain"), bytes);
+            let cloth: Vec<usize> = scene
+                .bodies
+                .iter()
+                .filter(|b| matches!(b.topology, hooke_scene::Topology::Grid(_)))
+                .flat_map(|b| b.range.clone())
+                .collect();
+            let values = ColorBy::Strain.values(&scene).unwrap_or_default();
+            let largest = cloth
+                .iter()
+                .filter_map(|&i| values.get(i))
+                .fold(f64::NEG_INFINITY, |m, v| m.max(*v));
+            Some(StrainPicture {
+                file: file("strain"),
+                largest,
+                weight,
+            })
+        }
+        None => None,
+    };
     Ok(SceneCheck {
         name: name.to_string(),
         time: scene.simulation.time(),
@@ -172,6 +246,7 @@ fn check(name: &str, golden: &[u8], files: &mut Pending) -> Result<SceneCheck> {
         still: file("still"),
         golden: file("golden"),
         diff: file("diff"),
+        strain,
     })
 }
 
