@@ -225,7 +225,7 @@ def test_render_colours_by_a_quantity_with_its_legend_and_places_the_camera():
     strain = sim.render(width=320, height=240, supersample=1, color="strain", range=(-5.0, 5.0))
     assert strain.shape == plain.shape and (strain != plain).any()
     # The legend's bar at the right edge: its top is coolwarm's red end.
-    right = strain[:, 240:, :].reshape(-1, 3).astype(int)
+    right = strain[:, 200:, :].reshape(-1, 3).astype(int)
     assert ((right[:, 0] - right[:, 2]) > 100).any(), "a red end of the bar"
     near = sim.render(width=320, height=240, supersample=1, distance=1.0, shadows=False)
     assert (near != plain).any()
