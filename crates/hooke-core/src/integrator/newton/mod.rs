@@ -24,7 +24,7 @@
 mod factor;
 
 use super::vbd::local::{Local, friction_stiffness};
-use super::vbd::{VbdBuffers, clip, keep_momentum, prepare};
+use super::vbd::{clip, finish, keep_momentum, prepare};
 use super::{StepReport, StopRule, Sym3, Workspace};
 use crate::model::Model;
 use crate::parallel;
@@ -187,25 +187,6 @@ pub(super) fn step(
     finish(b, (iterations, converged, last_move), p, start, dt);
     keep_momentum(model, p, start, &b.momentum, dt);
     StepReport::SAVED
-}
-
-/// Records the step's counts and sets the free particles' velocities `(x - x⁰) / dt`.
-fn finish(
-    b: &mut VbdBuffers,
-    (iterations, converged, last_move): (usize, bool, f64),
-    p: &mut Particles,
-    start: &[Vec3],
-    dt: f64,
-) {
-    b.iterations = iterations;
-    b.step_parts = 1;
-    b.capped = !converged;
-    b.last_speed = last_move / dt;
-    for (i, (v, (x, s))) in p.v.iter_mut().zip(p.x.iter().zip(start)).enumerate() {
-        if p.inv_mass[i] != 0.0 {
-            *v = (x - s) / dt;
-        }
-    }
 }
 
 /// The Newton system at `x`: each particle's force and diagonal block (block descent's

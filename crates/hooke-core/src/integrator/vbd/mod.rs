@@ -194,10 +194,6 @@ pub(in crate::integrator) fn step(
             b.times.detection += clock.lap();
         }
     }
-    b.iterations = iterations;
-    b.step_parts = 1;
-    b.capped = !converged;
-    b.last_speed = last_move / dt;
     if b.evidence {
         b.residual = residual(
             &Local {
@@ -213,13 +209,29 @@ pub(in crate::integrator) fn step(
             g,
         );
     }
+    finish(b, (iterations, converged, last_move), p, start, dt);
+    keep_momentum(model, p, start, &b.momentum, dt);
+    StepReport::SAVED
+}
+
+/// Records a large step's counts (block descent's or Newton's) and sets the free
+/// particles' velocities `(x - x⁰) / dt`.
+pub(in crate::integrator) fn finish(
+    b: &mut VbdBuffers,
+    (iterations, converged, last_move): (usize, bool, f64),
+    p: &mut Particles,
+    start: &[Vec3],
+    dt: f64,
+) {
+    b.iterations = iterations;
+    b.step_parts = 1;
+    b.capped = !converged;
+    b.last_speed = last_move / dt;
     for (i, (v, (x, s))) in p.v.iter_mut().zip(p.x.iter().zip(start)).enumerate() {
         if p.inv_mass[i] != 0.0 {
             *v = (x - s) / dt;
         }
     }
-    keep_momentum(model, p, start, &b.momentum, dt);
-    StepReport::SAVED
 }
 
 /// What block descent and Newton's step share before they iterate (docs/physics.md §4.1):
