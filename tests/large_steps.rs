@@ -442,25 +442,6 @@ friction = 0.0
     assert!((x.x - 2.0).abs() < 0.05, "travelled {} m", x.x);
 }
 
-/// Issue 54: a converged implicit step only takes energy out, so a gain beyond a hundredth
-/// of the start's energy scale stops the run as diverged, naming the energy, instead of
-/// ending it with exit 0: the built-in jelly cube (no contact thickness, dropped onto a
-/// restitution ground) gains energy on its landing at 1/60 s. (The jello worlds, which
-/// block descent used to flatten against their walls, keep their shape since the penalty
-/// walls' damping is read at the step's start: `newton.rs`, docs/physics.md §4.1.)
-#[test]
-fn block_descent_stops_rather_than_end_a_stiff_body_wrong() {
-    let at_60 = Overrides {
-        integrator: Some(Integrator::Vbd),
-        dt: Some(1.0 / 60.0),
-        ..Overrides::default()
-    };
-    let mut cube = crate::common::builtin("jello-cube", &at_60);
-    let steps = cube.steps;
-    let e = cube.simulation.advance(steps).unwrap_err().to_string();
-    assert!(e.contains("the energy grew"), "jello-cube: {e}");
-}
-
 /// Issue 55: block descent ends a step as IPC does: when its last iteration moved no free
 /// particle faster than the tolerance (its move over `dt`), or at its iteration budget, both
 /// from `[simulation]` or the command line. Every step of `cloth-table` landing on its table

@@ -4,6 +4,7 @@
 //! closed forms; snapshot tests lock real trajectories (see `tests/snapshots/`).
 
 mod air;
+mod bodies;
 mod collisions;
 mod common;
 mod conservation;

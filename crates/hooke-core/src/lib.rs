@@ -2,7 +2,7 @@
 //!
 //! Particles as flat arrays, springs as index pairs, the forces of the physics contract
 //! (`docs/physics.md` §1: damped springs, gravity, a force field on a grid, penalty springs),
-//! five integrators (§4), the three collision responses and the contact phase (§3). Units are SI throughout:
+//! seven integrators (§4), the three collision responses and the contact phase (§3). Units are SI throughout:
 //! metres, seconds, kilograms, newtons; scenes are +Y up.
 //!
 //! This crate knows nothing of parry3d, meshes, images, files or the command line: colliders

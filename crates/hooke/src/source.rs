@@ -164,11 +164,17 @@ pub fn build_prepared(source: Source, arg: &str) -> Result<Scene> {
     } else {
         Box::new(crate::progress::Hidden)
     };
-    let scene = source
+    let mut scene = source
         .spec
         .build(&source.base)
         .with_context(|| format!("scene '{arg}'"));
     spinner.finish();
+    if let Ok(scene) = &mut scene {
+        // A large step under way ends at an interrupt, so that Ctrl-C is answered within a
+        // fraction of a second whatever its tolerance (the driver then stops at the last
+        // complete frame).
+        scene.simulation.set_cancel(crate::interrupt::requested);
+    }
     if let Ok(scene) = &scene {
         for warning in scene.warnings() {
             eprintln!("warning: scene '{arg}': {warning}");

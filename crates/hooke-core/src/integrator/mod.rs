@@ -305,6 +305,17 @@ pub struct Workspace {
     pub(crate) kernel: Option<Kernel>,
     /// How block descent ends a step, when not its default.
     pub(crate) stop: Option<StopRule>,
+    /// Asked between the large steps' iterations (and inside Newton's conjugate gradients):
+    /// when it answers `true`, the step ends where its iterate is, every update still
+    /// within its bounds, so that an interrupt is seen within a fraction of a second at any
+    /// tolerance.
+    pub(crate) cancel: Option<fn() -> bool>,
+}
+
+/// Whether the large step under way should end now ([`Workspace::cancel`]).
+#[inline]
+pub(crate) fn cancelled(cancel: Option<fn() -> bool>) -> bool {
+    cancel.is_some_and(|f| f())
 }
 
 impl Workspace {

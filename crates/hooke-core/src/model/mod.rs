@@ -21,6 +21,10 @@ pub struct ColliderSlot {
     pub response: Response,
 }
 
+/// The most contact thickness a point keeps from a collider under the large steps, metres
+/// ([`Model::point_thickness`]).
+pub(crate) const POINT_THICKNESS: f64 = 1e-3;
+
 /// Springs, external forces and colliders, and the per-particle masses they act on.
 ///
 /// Forces are evaluated per docs/physics.md §1 by the spring assembly (`assembly/`), which sums them in an order
@@ -131,6 +135,23 @@ impl Model {
             .iter()
             .enumerate()
             .filter(|(_, s)| s.is_active())
+    }
+
+    /// The contact thickness the large steps (`vbd`, `newton`) keep between a particle
+    /// outside every active surface (a chain's, a lattice's, a point's) and a restitution or
+    /// stick collider, metres: 1 mm, or a quarter of the model's shortest
+    /// spring when that is less, so that a small body's neighbours are not thicknesses
+    /// apart. With none, the bounds of docs/physics.md §4.1 let such a particle approach a
+    /// collider by nine tenths of its gap per detection until rounding put it inside, where
+    /// nothing bounds it.
+    pub fn point_thickness(&self) -> f64 {
+        let shortest = self
+            .springs
+            .iter()
+            .map(|s| s.rest)
+            .filter(|&r| r > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        POINT_THICKNESS.min(0.25 * shortest)
     }
 
     /// The contact thickness of particle `p`: its surface's, zero for particles outside

@@ -161,6 +161,14 @@ impl Simulation {
         self.workspace.stop = Some(rule);
     }
 
+    /// Installs a question the large steps (`vbd`, `newton`) ask between their iterations:
+    /// when `cancel` answers `true` the step under way ends early where it is (within its
+    /// bounds, as a capped step), so that the caller, which asked for it (Ctrl-C), can stop
+    /// the run within a fraction of a second whatever the tolerance and iteration budget.
+    pub fn set_cancel(&mut self, cancel: fn() -> bool) {
+        self.workspace.cancel = Some(cancel);
+    }
+
     /// Whether block descent measures each step's residual (a sweep's cost; the benchmark
     /// reports it as evidence).
     pub fn measure_residuals(&mut self, on: bool) {
@@ -223,11 +231,16 @@ impl Simulation {
         self.particles = r.particles(&self.particles);
         self.initial = r.particles(&self.initial);
         r.model(&mut self.model);
-        let (kernel, stop) = (self.workspace.kernel, self.workspace.stop);
+        let (kernel, stop, cancel) = (
+            self.workspace.kernel,
+            self.workspace.stop,
+            self.workspace.cancel,
+        );
         let evidence = self.workspace.vbd.evidence;
         self.workspace = Workspace {
             kernel,
             stop,
+            cancel,
             ..Workspace::default()
         };
         self.workspace.vbd.evidence = evidence;

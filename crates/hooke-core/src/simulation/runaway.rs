@@ -60,6 +60,8 @@ pub(crate) struct EnergyWatch {
     carried: f64,
     /// The work supplied so far `W`, joules.
     supplied: f64,
+    /// The same work by source, joules: what the message names.
+    sources: Sources,
     /// The air's forces, evaluated at checks.
     air: AirForces,
 }
@@ -100,6 +102,7 @@ impl EnergyWatch {
             scale,
             carried,
             supplied: 0.0,
+            sources: Sources::default(),
             air: AirForces::default(),
         }
     }
@@ -124,19 +127,24 @@ impl EnergyWatch {
         if !self.enabled || !step.is_multiple_of(self.interval) {
             return Ok(());
         }
-        self.supplied += self.interval as f64 * dt * self.power(model, p, time);
+        let span = self.interval as f64 * dt;
+        let power = self.power(model, p, time);
+        self.sources.add(&power, span);
+        self.supplied += span * power.total();
         let e = energy(model, p);
         let allowed = if integrator.dissipates() {
             DISSIPATIVE_SLACK * (self.scale - self.carried) + self.carried + 2.0 * self.supplied
         } else {
             GROWTH * self.scale + 2.0 * self.supplied
         };
-        if e - self.start <= allowed || !e.is_finite() {
-            // A non-finite state is the sanity check's to name.
+        // Energy that fell, or stayed, came from nowhere: never a runaway. A non-finite
+        // state is the sanity check's to name; an allowance that is not a number (it never
+        // should be) stops nothing.
+        if e <= self.start || e - self.start <= allowed || !e.is_finite() || allowed.is_nan() {
             return Ok(());
         }
         let particle = fastest(p);
-        let cause = likely_cause(model, p);
+        let cause = format!("{}{}", self.sources.largest(model), likely_cause(model, p));
         let stable_dt = StabilityEstimate::of(model, initial).max_dt(integrator);
         Err(Divergence {
             step,
@@ -144,8 +152,8 @@ impl EnergyWatch {
             particle,
             what: format!(
                 "moves at {:.3e} m/s: the energy grew from {:.4e} J to {:.4e} J, far beyond \
-                 the {:.3e} J that the field, the air, the attachments and the keyed pins \
-                 supplied{cause}",
+                 the {:.3e} J that the field, the air, the attachments, the keyed pins and the \
+                 moving colliders supplied{cause}",
                 p.v[particle].norm(),
                 self.start,
                 e,
@@ -159,33 +167,101 @@ impl EnergyWatch {
         })
     }
 
-    /// The power that forces from outside the springs and gravity put in now, counting only
-    /// where they push a particle along its motion.
-    fn power(&mut self, model: &Model, p: &Particles, time: f64) -> f64 {
-        let pins = pin_power(model, p);
+    /// The power that forces from outside the springs and gravity put in now, by source,
+    /// counting only where they push a particle along its motion.
+    fn power(&mut self, model: &Model, p: &Particles, time: f64) -> Power {
+        let mut power = Power {
+            pins: pin_power(model, p),
+            colliders: collider_power(model, p),
+            ..Power::default()
+        };
         if model.field.is_none() && model.air.is_none() && model.attachments.is_empty() {
-            return pins;
+            return power;
         }
         self.air.ensure(&model.aero, p.len());
         let air = self
             .air
             .evaluate(model.air.as_ref(), &model.aero, &p.x, &p.v, time);
-        let mut power = 0.0;
         for i in 0..p.len() {
             if p.inv_mass[i] == 0.0 {
                 continue;
             }
             let (x, v) = (&p.x[i], &p.v[i]);
-            let mut f = model.attachment_force(i, x, v);
+            power.attachments += model.attachment_force(i, x, v).dot(v).max(0.0);
             if let Some(field) = &model.field {
-                f += field.sample(x);
+                power.field += field.sample(x).dot(v).max(0.0);
             }
             if let Some(a) = air.get(i) {
-                f += a;
+                power.air += a.dot(v).max(0.0);
             }
-            power += f.dot(v).max(0.0);
         }
-        power + pins
+        power
+    }
+}
+
+/// The power each source outside the springs and gravity puts in at a check, watts.
+#[derive(Clone, Debug, Default)]
+struct Power {
+    field: f64,
+    air: f64,
+    attachments: f64,
+    pins: f64,
+    /// Per collider (zero for the still ones).
+    colliders: Vec<f64>,
+}
+
+impl Power {
+    fn total(&self) -> f64 {
+        self.field + self.air + self.attachments + self.pins + self.colliders.iter().sum::<f64>()
+    }
+}
+
+/// The work each source supplied so far, joules.
+#[derive(Clone, Debug, Default)]
+struct Sources {
+    field: f64,
+    air: f64,
+    attachments: f64,
+    pins: f64,
+    colliders: Vec<f64>,
+}
+
+impl Sources {
+    fn add(&mut self, power: &Power, span: f64) {
+        self.field += span * power.field;
+        self.air += span * power.air;
+        self.attachments += span * power.attachments;
+        self.pins += span * power.pins;
+        self.colliders
+            .resize(power.colliders.len().max(self.colliders.len()), 0.0);
+        for (w, p) in self.colliders.iter_mut().zip(&power.colliders) {
+            *w += span * p;
+        }
+    }
+
+    /// The source that supplied the most, said after a `; ` (nothing when none did).
+    fn largest(&self, model: &Model) -> String {
+        let mut named = vec![
+            (self.field, "the force field".to_string()),
+            (self.air, "the air".to_string()),
+            (self.attachments, "the attachments".to_string()),
+            (self.pins, "the keyed pins ([body.pin_motion])".to_string()),
+        ];
+        for (k, &w) in self.colliders.iter().enumerate() {
+            if let Some(slot) = model.colliders.get(k) {
+                named.push((
+                    w,
+                    format!("collider[{k}] ({}), moving by its keys", slot.shape.name()),
+                ));
+            }
+        }
+        named
+            .into_iter()
+            .filter(|(w, _)| *w > 0.0)
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .map_or_else(String::new, |(w, name)| {
+                format!("; the largest source of work is {name}, {w:.3e} J")
+            })
     }
 }
 
@@ -203,8 +279,12 @@ fn collider_allowance(model: &Model, (lo, hi): (&Vec3, &Vec3), free_mass: f64) -
         let (mut speed, mut path) = (0.0_f64, 0.0_f64);
         for pair in keys.keys().windows(2) {
             let (ta, tb) = (pair[0].t, pair[1].t);
-            let step = (tb - ta) / SPANS_PER_KEY as f64;
-            for k in 0..SPANS_PER_KEY {
+            // A sweep has no bound for a turn of 60° or more: a spinning collider's span is
+            // cut until each part turns at most 30° about every axis.
+            let turn = (pair[1].rotate - pair[0].rotate).abs().max();
+            let spans = SPANS_PER_KEY.max((turn / 30.0).ceil().min(1e6) as usize);
+            let step = (tb - ta) / spans as f64;
+            for k in 0..spans {
                 let t = ta + step * k as f64;
                 let s = slot.shape.sweep((t, t + step), lo, hi);
                 path += s;
@@ -248,6 +328,45 @@ fn pin_power(model: &Model, p: &Particles) -> f64 {
         .filter(|&i| moving[i])
         .map(|i| (held[i] - model.gravity * p.mass[i]).dot(&p.v[i]).max(0.0))
         .sum()
+}
+
+/// The power each moving collider puts in now: a particle touching it (inside it, or
+/// within its contact thickness or a point's) is held against its springs and its weight,
+/// as a keyed pin is, so the collider's force on it is minus their sum, counted where the
+/// collider's surface there moves along it. Still colliders do no work (zero).
+fn collider_power(model: &Model, p: &Particles) -> Vec<f64> {
+    let mut power = vec![0.0; model.colliders.len()];
+    if !model.colliders.iter().any(|c| c.shape.is_moving()) {
+        return power;
+    }
+    let mut held = vec![Vec3::zeros(); p.len()];
+    for s in &model.springs {
+        let (i, j) = (s.i as usize, s.j as usize);
+        let f = s.force(&p.x[i], &p.x[j], &p.v[i], &p.v[j]);
+        held[i] -= f;
+        held[j] += f;
+    }
+    for (k, slot) in model.colliders.iter().enumerate() {
+        if !slot.shape.is_moving() {
+            continue;
+        }
+        for i in (0..p.len()).filter(|&i| p.inv_mass[i] != 0.0) {
+            let margin = model.margin(i).max(model.point_thickness());
+            let mut normal = None;
+            slot.shape
+                .contacts_within(&p.x[i], 2.0 * margin, &mut |c| normal = Some(c));
+            let Some(c) = normal else {
+                continue;
+            };
+            // The collider pushes along its normal only: what holds the particle there.
+            let push = (held[i] - model.gravity * p.mass[i])
+                .dot(&c.normal)
+                .max(0.0);
+            let along = slot.shape.velocity(&c.point).dot(&c.normal);
+            power[k] += (push * along).max(0.0);
+        }
+    }
+    power
 }
 
 /// The fastest particle.

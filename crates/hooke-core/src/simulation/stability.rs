@@ -6,7 +6,8 @@
 //! iteration from a fixed start vector, so the estimate is deterministic. Penalty colliders add
 //! `kc` to every particle's diagonal, a bound for the particles that touch them, and the air
 //! its stiffness at the strongest wind (see `diagonal_stiffness`). Damping limits the step
-//! too: `γ_max`, a bound on the fastest damping rate, must keep `dt γ_max` inside the
+//! too: `γ_max`, the fastest damping rate (the largest eigenvalue of `M⁻¹ C`, found the
+//! same way), must keep `dt γ_max` inside the
 //! scheme's real stability interval.
 
 use crate::collider::response::Response;
@@ -21,8 +22,8 @@ use crate::particles::{Particles, Vec3};
 pub struct StabilityEstimate {
     /// Highest angular frequency `ω_max` in rad/s (zero for a system without springs).
     pub omega_max: f64,
-    /// Fastest damping rate `γ_max` in 1/s: a Gershgorin bound on the largest eigenvalue of
-    /// `M⁻¹ C`, with `C` the velocity Jacobian of spring damping, drag, penalty damping and
+    /// Fastest damping rate `γ_max` in 1/s: the largest eigenvalue of `M⁻¹ C` by power
+    /// iteration (at most its Gershgorin bound), with `C` the velocity Jacobian of spring damping, drag, penalty damping and
     /// the air (linearised at the state's velocities against the strongest wind the air
     /// blows). An explicit scheme also needs `dt γ_max` inside its real stability interval.
     pub damping_max: f64,
@@ -44,30 +45,19 @@ impl StabilityEstimate {
                 damping_max,
             };
         }
-        // A fixed, non-symmetric start vector so no mode is missed by symmetry.
-        let mut u: Vec<Vec3> = (0..n)
-            .map(|i| {
-                let t = i as f64;
-                Vec3::new(
-                    (t * 0.7548).sin() + 1.1,
-                    (t * 0.5698).cos() + 1.3,
-                    (t * 0.3141).sin() + 1.7,
-                )
-            })
-            .collect();
-        let mut w = vec![Vec3::zeros(); n];
-        let mut lambda = 0.0;
         let diagonal = diagonal_stiffness(model, particles, penalty_k);
-        for _ in 0..POWER_ITERATIONS {
-            normalise(&mut u);
-            apply(model, particles, &diagonal, &u, &mut w);
-            lambda = parallel::dot(&u, &w);
-            std::mem::swap(&mut u, &mut w);
-        }
-        // The Rayleigh quotient converges from below; the last growth factor bounds the error.
-        let growth = parallel::dot(&u, &u).sqrt();
+        let lambda = largest_eigenvalue(particles, &diagonal, |u, out| {
+            for s in &model.springs {
+                add_spring(
+                    particles,
+                    (s.i as usize, s.j as usize, s.rest, s.ks),
+                    u,
+                    out,
+                );
+            }
+        });
         Self {
-            omega_max: lambda.max(growth).max(0.0).sqrt(),
+            omega_max: lambda.sqrt(),
             damping_max,
         }
     }
@@ -114,12 +104,25 @@ impl StabilityEstimate {
 
     /// The largest stable step of `integrator` in seconds: its
     /// [`Integrator::stability_radius`] over `ω_max`, and its real stability interval over
-    /// `γ_max`, whichever is smaller; infinite where the scheme has no such limit (backward
+    /// `γ_max`, whichever is smaller (symplectic Euler: `ω² dt² + 2 γ dt ≤ 4` for the two
+    /// together); infinite where the scheme has no such limit (backward
     /// Euler) or the system neither springs nor damping.
     pub fn max_dt(&self, integrator: Integrator) -> f64 {
         let radius = integrator.stability_radius();
         if !radius.is_finite() {
             return f64::INFINITY;
+        }
+        if integrator == Integrator::Symplectic {
+            // Symplectic Euler on a mode `ẍ = -ω² x - γ ẋ` is stable exactly while
+            // `ω² dt² + 2 γ dt ≤ 4` (its characteristic polynomial's roots on the unit disc);
+            // a lattice's stiffest mode is also its most damped, so the two count together.
+            let (w, g) = (self.omega_max, self.damping_max);
+            let root = (g * g + 4.0 * w * w).sqrt();
+            return if root + g == 0.0 {
+                f64::INFINITY
+            } else {
+                4.0 / (g + root)
+            };
         }
         let oscillation = if self.omega_max == 0.0 {
             f64::INFINITY
@@ -144,9 +147,14 @@ fn real_interval(integrator: Integrator) -> f64 {
     }
 }
 
-/// [`StabilityEstimate::damping_max`]: per free particle, the damping coefficients acting on
-/// it summed (twice each spring's `kd`, as Gershgorin's row sum counts both ends), over its
-/// mass; the largest.
+/// [`StabilityEstimate::damping_max`]: the largest eigenvalue of `M⁻¹ C` by power iteration
+/// (as `ω_max²` of `M⁻¹ K`), with `C` each spring's damping `kd u uᵀ` between its ends (a
+/// zero-length spring's `kd I`) and on its diagonal what damps each particle alone: drag,
+/// the penalty colliders' `dc` (the most a particle touching all of them feels) and the
+/// air. The row sums' bound (Gershgorin's, counting every spring at a particle in every
+/// direction) overstated a lattice's rate by three times, and with it called the built-in
+/// jelly cube's own step unstable; it still bounds the estimate from above, which is kept
+/// at most that.
 fn damping_rate(model: &Model, p: &Particles) -> f64 {
     let penalty_dc: f64 = model
         .colliders
@@ -156,24 +164,113 @@ fn damping_rate(model: &Model, p: &Particles) -> f64 {
             _ => 0.0,
         })
         .sum();
-    let mut row: Vec<f64> = p
+    let mut diagonal: Vec<f64> = p
         .mass
         .iter()
         .map(|&m| model.drag_on(m) + penalty_dc)
         .collect();
-    for s in &model.springs {
-        row[s.i as usize] += 2.0 * s.kd;
-        row[s.j as usize] += 2.0 * s.kd;
-    }
     // A triangle's force `½ ρ A C |u| u` changes by at most `ρ A C |u|` per unit of its
     // mean velocity; a corner moves that mean by a third and takes a third of it.
-    add_air(model, p, &mut row, |t| t.rho_c * t.area * t.speed / 3.0);
-    row.iter()
+    add_air(model, p, &mut diagonal, |t| {
+        t.rho_c * t.area * t.speed / 3.0
+    });
+    let mut row = diagonal.clone();
+    for s in &model.springs {
+        row[s.i as usize] += 2.0 * s.kd.abs();
+        row[s.j as usize] += 2.0 * s.kd.abs();
+    }
+    let bound = row
+        .iter()
         .zip(&p.mass)
         .zip(&p.inv_mass)
         .filter(|(_, inv)| **inv != 0.0)
         .map(|((k, m), _)| k / m)
-        .fold(0.0, f64::max)
+        .fold(0.0, f64::max);
+    if bound == 0.0 || model.springs.iter().all(|s| s.kd == 0.0) {
+        return bound;
+    }
+    let damping: Vec<(u32, u32, f64, f64)> = model
+        .springs
+        .iter()
+        .map(|s| (s.i, s.j, s.rest, s.kd))
+        .collect();
+    let rate = largest_eigenvalue(p, &diagonal, |u, out| {
+        for &(i, j, rest, kd) in &damping {
+            let (i, j) = (i as usize, j as usize);
+            add_spring(p, (i, j, rest, kd), u, out);
+        }
+    });
+    rate.min(bound)
+}
+
+/// The largest eigenvalue of `M⁻¹ (D + S)` by [`POWER_ITERATIONS`] of the power method from
+/// a fixed start vector (deterministic), with `D` the diagonal `diagonal` and `S` what
+/// `springs(u, out)` adds to `out`; the larger of the last Rayleigh quotient and growth
+/// factor, since the quotient converges from below.
+fn largest_eigenvalue(
+    p: &Particles,
+    diagonal: &[f64],
+    springs: impl Fn(&[Vec3], &mut [Vec3]),
+) -> f64 {
+    let n = p.len();
+    // A fixed, non-symmetric start vector so no mode is missed by symmetry.
+    let mut u: Vec<Vec3> = (0..n)
+        .map(|i| {
+            let t = i as f64;
+            Vec3::new(
+                (t * 0.7548).sin() + 1.1,
+                (t * 0.5698).cos() + 1.3,
+                (t * 0.3141).sin() + 1.7,
+            )
+        })
+        .collect();
+    let mut w = vec![Vec3::zeros(); n];
+    let mut lambda = 0.0;
+    for _ in 0..POWER_ITERATIONS {
+        normalise(&mut u);
+        for ((o, x), k) in w.iter_mut().zip(&u).zip(diagonal) {
+            *o = x * *k;
+        }
+        springs(&u, &mut w);
+        for ((o, m), inv) in w.iter_mut().zip(&p.mass).zip(&p.inv_mass) {
+            // Pinned particles do not move: their rows vanish.
+            *o = if *inv == 0.0 { Vec3::zeros() } else { *o / *m };
+        }
+        lambda = parallel::dot(&u, &w);
+        std::mem::swap(&mut u, &mut w);
+    }
+    let growth = parallel::dot(&u, &u).sqrt();
+    lambda.max(growth).max(0.0)
+}
+
+/// Adds a spring's `k u uᵀ` between ends `i` and `j` (a zero-length spring's `k I`) applied
+/// to `u` to `out`, `u` its direction at the particles' positions; a degenerate or overflowed
+/// spring adds nothing.
+fn add_spring(
+    p: &Particles,
+    (i, j, rest, k): (usize, usize, f64, f64),
+    u: &[Vec3],
+    out: &mut [Vec3],
+) {
+    // A zero-length spring (a material's bending) is `k I` in every direction: its
+    // geometric term is not small.
+    if rest == 0.0 {
+        let f = (u[i] - u[j]) * k;
+        out[i] += f;
+        out[j] -= f;
+        return;
+    }
+    let d = p.x[i] - p.x[j];
+    let len = d.norm();
+    // Degenerate springs have no direction; neither do springs at a particle that has
+    // overflowed (a diverged state rebuilt by undoing the step).
+    if !(len >= crate::forces::spring::DEGENERATE_LENGTH && len.is_finite()) {
+        return;
+    }
+    let dir = d / len;
+    let f = dir * (k * dir.dot(&(u[i] - u[j])));
+    out[i] += f;
+    out[j] -= f;
 }
 
 /// What each particle feels besides its springs, as a stiffness on the diagonal of `K`: the
@@ -243,38 +340,6 @@ fn penalty_stiffness(model: &Model) -> f64 {
             _ => 0.0,
         })
         .sum()
-}
-
-fn apply(model: &Model, p: &Particles, diagonal: &[f64], u: &[Vec3], out: &mut [Vec3]) {
-    for ((o, x), k) in out.iter_mut().zip(u).zip(diagonal) {
-        *o = x * *k;
-    }
-    for s in &model.springs {
-        let (i, j) = (s.i as usize, s.j as usize);
-        // A zero-length spring (a material's bending) is `ks I` in every direction: its
-        // geometric term is not small.
-        if s.rest == 0.0 {
-            let f = (u[i] - u[j]) * s.ks;
-            out[i] += f;
-            out[j] -= f;
-            continue;
-        }
-        let d = p.x[i] - p.x[j];
-        let len = d.norm();
-        // Degenerate springs have no direction; neither do springs at a particle that has
-        // overflowed (a diverged state rebuilt by undoing the step).
-        if !(len >= crate::forces::spring::DEGENERATE_LENGTH && len.is_finite()) {
-            continue;
-        }
-        let dir = d / len;
-        let f = dir * (s.ks * dir.dot(&(u[i] - u[j])));
-        out[i] += f;
-        out[j] -= f;
-    }
-    for ((o, m), inv) in out.iter_mut().zip(&p.mass).zip(&p.inv_mass) {
-        // Pinned particles do not move: their rows of M⁻¹K vanish.
-        *o = if *inv == 0.0 { Vec3::zeros() } else { *o / *m };
-    }
 }
 
 fn normalise(u: &mut [Vec3]) {

@@ -47,6 +47,9 @@ const STALLED: f64 = 0.01;
 const DETECT_SHARE: f64 = 0.01;
 /// Particles per parallel chunk.
 const CHUNK: usize = 512;
+/// Conjugate-gradient iterations between two looks at the cancel question (each a pass
+/// over the springs and a preconditioner solve).
+const CANCEL_EVERY: usize = 8;
 
 /// Newton's buffers, kept between steps.
 #[derive(Clone, Debug, Default)]
@@ -87,6 +90,7 @@ pub(super) fn step(
 ) -> StepReport {
     let mut clock = super::Lap::start();
     let rule = ws.stop.unwrap_or(StopRule::NEWTON);
+    let cancel = ws.cancel;
     let n = p.len();
     prepare(model, p, (t, dt), ws, &mut clock);
     let (b, nb) = (&mut ws.vbd, &mut ws.newton);
@@ -113,7 +117,7 @@ pub(super) fn step(
     let start = &ws.x0;
     let (mut iterations, mut converged, mut last_move) = (0, false, 0.0);
     nb.cg_iterations = 0;
-    while iterations < rule.iterations {
+    while iterations < rule.iterations && !super::cancelled(cancel) {
         iterations += 1;
         let local = Local {
             model,
@@ -125,7 +129,7 @@ pub(super) fn step(
             dt,
         };
         assemble(&local, &p.x, nb);
-        nb.cg_iterations += solve(&local, nb, model.springs.len());
+        nb.cg_iterations += solve(&local, nb, model.springs.len(), cancel);
         b.times.sweeps += clock.lap();
         // Backtracking on the energy, every trial point clipped to its bounds.
         let before = local.energy(&p.x, &p.x, &nb.pinned, &mut nb.parts);
@@ -303,7 +307,12 @@ const FEWEST_ITERATIONS: usize = 16;
 /// a factorisation costs, counted in multiply-adds, and only then factors at the current
 /// iterate and finishes with that: never more than twice the cheaper choice's cost (the
 /// rent-or-buy rule). Counts, not clocks, decide: the same bits on any machine.
-fn solve(local: &Local<'_>, nb: &mut NewtonBuffers, springs: usize) -> usize {
+fn solve(
+    local: &Local<'_>,
+    nb: &mut NewtonBuffers,
+    springs: usize,
+    cancel: Option<fn() -> bool>,
+) -> usize {
     nb.direction.fill(Vec3::zeros());
     let norm = parallel::dot(&nb.force, &nb.force).sqrt();
     if norm == 0.0 {
@@ -316,8 +325,8 @@ fn solve(local: &Local<'_>, nb: &mut NewtonBuffers, springs: usize) -> usize {
     let multiply = 18.0 * (n + nb.springs.len()) as f64;
     let per_iteration = if stale { multiply + solving } else { multiply };
     let budget = ((factoring / per_iteration) as usize).clamp(FEWEST_ITERATIONS, CG_MAX_ITERATIONS);
-    let (done, converged) = conjugate_gradients(local, nb, norm, budget, stale);
-    if converged {
+    let (done, converged) = conjugate_gradients(local, nb, norm, budget, stale, cancel);
+    if converged || super::cancelled(cancel) {
         return done;
     }
     {
@@ -331,7 +340,14 @@ fn solve(local: &Local<'_>, nb: &mut NewtonBuffers, springs: usize) -> usize {
         );
         nb.couplings = pairs;
     }
-    let (more, _) = conjugate_gradients(local, nb, norm, CG_MAX_ITERATIONS - done, nb.factor.ready);
+    let (more, _) = conjugate_gradients(
+        local,
+        nb,
+        norm,
+        CG_MAX_ITERATIONS - done,
+        nb.factor.ready,
+        cancel,
+    );
 
     done + more
 }
@@ -374,6 +390,7 @@ fn conjugate_gradients(
     norm: f64,
     budget: usize,
     factored: bool,
+    cancel: Option<fn() -> bool>,
 ) -> (usize, bool) {
     let mut d = std::mem::take(&mut nb.direction);
     let mut r = std::mem::take(&mut nb.r);
@@ -399,6 +416,11 @@ fn conjugate_gradients(
         s.copy_from_slice(&z);
         let mut delta = parallel::dot(&r, &z);
         while iterations < budget {
+            // An interrupt ends the solve with the direction it has (still a descent
+            // direction of the preconditioned system), checked every few products.
+            if iterations % CANCEL_EVERY == 0 && super::cancelled(cancel) {
+                break;
+            }
             iterations += 1;
             multiply(local, nb, &s, &mut q);
             let curvature = parallel::dot(&s, &q);

@@ -44,7 +44,6 @@ const FELT: f64 = 2.0;
 pub(crate) const CONTACT_STIFFNESS: f64 = 1.0;
 /// Particles (or triangles, edges) per parallel chunk of the detection.
 const CHUNK: usize = 512;
-
 /// How near a primitive's nearest neighbour is, and its nearest neighbour whose contact is
 /// not felt (farther than [`FELT`] thicknesses), capped at the search's reach.
 #[derive(Clone, Copy, Debug)]
@@ -92,6 +91,9 @@ pub(in crate::integrator) struct Topology {
     pub(in crate::integrator) surface: Vec<u16>,
     /// Whether any surface pair (self or between bodies) can touch.
     self_pairs: bool,
+    /// The thickness particles outside every active surface keep from velocity-level
+    /// colliders ([`Model::point_thickness`]).
+    point: f64,
     /// Per triangle: which of its edges (bits 0..3: ab, bc, ca) and corners (bits 3..6)
     /// it owns, being the first triangle of its surface to have them.
     owns: Vec<u8>,
@@ -106,10 +108,30 @@ impl Topology {
         }
     }
 
+    /// The thickness particle `i` keeps from the colliders that bound it (velocity-level
+    /// ones): its surface's, or the point thickness outside every active surface.
+    fn contact_margin(&self, model: &Model, i: usize) -> f64 {
+        match self.surface[i] {
+            u16::MAX => self.point,
+            s => model.surfaces[s as usize].thickness,
+        }
+    }
+
+    /// The thickness particle `i` keeps from a collider answering with `response`: its
+    /// surface's from a penalty wall (the course's force field, which it may enter), and
+    /// at least the point thickness from the others.
+    fn keeps(&self, model: &Model, i: usize, response: &Response) -> f64 {
+        match response {
+            Response::Penalty { .. } => self.margin(model, i),
+            _ => self.contact_margin(model, i),
+        }
+    }
+
     fn new(model: &Model, n: usize) -> Self {
         let mut t = Self {
             built_for: n,
             surface: vec![u16::MAX; n],
+            point: model.point_thickness(),
             ..Self::default()
         };
         let active: Vec<_> = model.active_surfaces().collect();
@@ -355,10 +377,17 @@ impl Detection {
         self.touches[i].count != 0 || self.start[i] != self.start[i + 1]
     }
 
-    /// The thickness particle `i` keeps from colliders.
+    /// The thickness particle `i` keeps from penalty colliders: its surface's.
     #[inline]
     pub(in crate::integrator) fn margin(&self, model: &Model, i: usize) -> f64 {
         self.topology.margin(model, i)
+    }
+
+    /// The thickness particle `i` keeps from a collider answering with `response`: a point
+    /// keeps [`Model::point_thickness`] from velocity-level colliders.
+    #[inline]
+    pub(in crate::integrator) fn keeps(&self, model: &Model, i: usize, response: &Response) -> f64 {
+        self.topology.keeps(model, i, response)
     }
 
     /// Detects at positions `x` (the current iterate), with `y` the step's inertial targets
@@ -384,6 +413,12 @@ impl Detection {
             .map(|(_, s)| s.thickness)
             .fold(0.0, f64::max);
         self.h_max = h_max;
+        let points = self.topology.surface.contains(&u16::MAX);
+        let h_collider = if points {
+            h_max.max(self.topology.point)
+        } else {
+            h_max
+        };
         let travel = (0..n)
             .filter(|&i| !p.is_pinned(i))
             .map(|i| (y[i] - x[i]).norm())
@@ -392,7 +427,7 @@ impl Detection {
         let collider_reach = if model.colliders.is_empty() {
             f64::INFINITY
         } else {
-            (COLLIDER_REACH * h_max).max(4.0 * travel).max(1e-6)
+            (COLLIDER_REACH * h_collider).max(4.0 * travel).max(1e-6)
         };
         self.detect_colliders(model, x, collider_reach);
         self.detect_features(model, x, collider_reach, dt);
@@ -417,7 +452,6 @@ impl Detection {
         self.touches.resize(n, Touches::default());
         self.halves.resize(n, HalfSpaces::default());
         let one = |i: usize, (clearance, near, halves): (&mut Clearance, &mut Touches, &mut HalfSpaces)| {
-            let margin = topology.margin(model, i);
             let (lo, hi) = (x[i].add_scalar(-reach), x[i].add_scalar(reach));
             *clearance = Clearance::new(reach);
             *near = Touches::default();
@@ -430,6 +464,7 @@ impl Detection {
                 // A penalty collider is a force field the course lets particles enter: it
                 // bounds nothing, and its surface is felt wherever the search reaches.
                 let force = slot.response.is_force();
+                let margin = topology.keeps(model, i, &slot.response);
                 slot.shape.contacts_within(&x[i], reach, &mut |c| {
                     let d = reach - c.depth;
                     // Inside already: no bound from it (staying is no crossing); its
@@ -712,7 +747,7 @@ impl Detection {
         allowed.clear();
         allowed.extend(
             (0..collider.len())
-                .map(|i| collider[i].allows(GAMMA_COLLIDER, topo.margin(model, i), 1.0)),
+                .map(|i| collider[i].allows(GAMMA_COLLIDER, topo.contact_margin(model, i), 1.0)),
         );
         self.scratch_collider = collider;
         allowed

@@ -312,14 +312,14 @@ impl Local<'_> {
     /// normal force lagged at `base` (see [`Local::energy`]).
     fn collider_energy(&self, i: usize, (xi, base): (&Vec3, &Vec3), moved: Vec3) -> f64 {
         let touches = self.detection.touches[i].planes();
-        let margin = self.detection.margin(self.model, i);
         let dt = self.dt;
         let mut e = 0.0;
         for plane in touches {
             let n = plane.normal;
             let d = n.dot(&(xi - plane.point));
-            let depth = margin - d;
             let slot = &self.model.colliders[plane.collider as usize];
+            let margin = self.detection.keeps(self.model, i, &slot.response);
+            let depth = margin - d;
             let moved = if slot.shape.is_moving() {
                 moved - slot.shape.velocity(&plane.point) * dt
             } else {
@@ -420,13 +420,13 @@ impl Local<'_> {
         if touches.is_empty() {
             return;
         }
-        let margin = self.detection.margin(self.model, i);
         let dt = self.dt;
         for plane in touches {
             let n = plane.normal;
             let d = n.dot(&(xi - plane.point));
-            let depth = margin - d;
             let slot = &self.model.colliders[plane.collider as usize];
+            let margin = self.detection.keeps(self.model, i, &slot.response);
+            let depth = margin - d;
             let penalty = matches!(slot.response, Response::Penalty { .. });
             if d >= margin * (1.0 + BAND) && !penalty {
                 continue;

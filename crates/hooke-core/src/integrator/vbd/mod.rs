@@ -95,6 +95,7 @@ pub(in crate::integrator) fn step(
 ) -> StepReport {
     let mut clock = crate::integrator::Lap::start();
     let rule = ws.stop.unwrap_or(StopRule::VBD);
+    let cancel = ws.cancel;
     let n = p.len();
     prepare(model, p, (t, dt), ws, &mut clock);
     let b = &mut ws.vbd;
@@ -110,8 +111,8 @@ pub(in crate::integrator) fn step(
     let start = &ws.x0;
     let mut iterations = 0;
     let mut converged = false;
-    let mut last_move = 0.0;
-    while iterations < rule.iterations {
+    let (mut last_move, mut before_last) = (0.0, 0.0);
+    while iterations < rule.iterations && !super::cancelled(cancel) {
         iterations += 1;
         let mut largest = 0.0_f64;
         let mut held = 0;
@@ -153,10 +154,23 @@ pub(in crate::integrator) fn step(
         largest = largest.max(moved);
         held += c;
         b.times.coarse += clock.lap();
-        last_move = largest;
         // The anchors' rule (IPC's): the step is solved when its last update moved no
         // particle faster than the tolerance over the step, and none waits at its bound.
-        let settled = largest <= rule.tolerance * dt;
+        // Gauss–Seidel on a stiff or volumetric body crawls towards its solution by small
+        // updates that shrink slowly; what is left to go is about the update over one less
+        // its contraction `r` (the larger of the last two updates' ratios), and that is
+        // what the tolerance bounds.
+        let ratio = |now: f64, before: f64| {
+            if before > 0.0 {
+                (now / before).min(1.0)
+            } else {
+                0.0
+            }
+        };
+        let contraction = ratio(largest, last_move).max(ratio(last_move, before_last));
+        let settled = largest <= (1.0 - contraction) * rule.tolerance * dt;
+        before_last = last_move;
+        last_move = largest;
         if settled && held == 0 {
             converged = true;
             break;
