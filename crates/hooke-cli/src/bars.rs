@@ -3,7 +3,8 @@
 
 use hooke::progress::{Progress, Reporter};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
+use std::collections::VecDeque;
 use std::io::IsTerminal;
 use std::time::{Duration, Instant};
 
@@ -24,6 +25,46 @@ fn line_every() -> Duration {
         .map_or(LINE_EVERY, Duration::from_secs_f64)
 }
 
+/// How far back the time-left estimate looks: a run whose steps grow slower (a collider
+/// reaching the cloth, a landing) is judged by its recent steps, not by its start.
+const RECENT: Duration = Duration::from_secs(20);
+
+/// The time left of a run, from the rate of its steps over the last [`RECENT`] seconds.
+#[derive(Default)]
+struct TimeLeft {
+    /// `(when, steps done)`, oldest first, spanning about [`RECENT`].
+    samples: RefCell<VecDeque<(Instant, u64)>>,
+}
+
+impl TimeLeft {
+    /// Records that `done` steps are done now, and says about how many seconds the
+    /// remaining `total - done` take at the recent rate (`None` before there is one).
+    fn after(&self, now: Instant, done: u64, total: u64) -> Option<f64> {
+        let mut samples = self.samples.borrow_mut();
+        samples.push_back((now, done));
+        while samples.len() > 2 && now.duration_since(samples[1].0) >= RECENT {
+            samples.pop_front();
+        }
+        let (t0, d0) = *samples.front()?;
+        let seconds = now.duration_since(t0).as_secs_f64();
+        let steps = done.saturating_sub(d0);
+        (steps > 0 && seconds > 0.0)
+            .then(|| total.saturating_sub(done) as f64 * seconds / steps as f64)
+    }
+}
+
+/// Seconds as a person reads them: `42 s`, `3 min 5 s`, `2 h 10 min`.
+fn human(seconds: f64) -> String {
+    let s = seconds.round() as u64;
+    if s < 60 {
+        format!("{s} s")
+    } else if s < 3600 {
+        format!("{} min {} s", s / 60, s % 60)
+    } else {
+        format!("{} h {} min", s / 3600, (s % 3600) / 60)
+    }
+}
+
 /// Draws bars on stderr when it is a terminal; otherwise writes a line of progress every
 /// ten seconds of a run, and says that a large build takes a while.
 pub struct Bars;
@@ -33,11 +74,17 @@ struct Bar {
     bar: ProgressBar,
     started: Instant,
     shown: Cell<bool>,
+    left: TimeLeft,
 }
 
 impl Progress for Bar {
     fn set(&self, done: u64) {
         self.bar.set_position(done);
+        if let Some(total) = self.bar.length()
+            && let Some(left) = self.left.after(Instant::now(), done, total)
+        {
+            self.bar.set_message(format!("about {} left", human(left)));
+        }
         if !self.shown.get() && self.started.elapsed() >= SHOW_AFTER {
             self.shown.set(true);
             self.bar.set_draw_target(ProgressDrawTarget::stderr());
@@ -56,22 +103,20 @@ struct Lines {
     every: Duration,
     started: Instant,
     last: Cell<Instant>,
+    left: TimeLeft,
 }
 
 impl Progress for Lines {
     fn set(&self, done: u64) {
         let now = Instant::now();
+        let left = self.left.after(now, done, self.steps);
         if now.duration_since(self.last.get()) < self.every {
             return;
         }
         self.last.set(now);
         let elapsed = now.duration_since(self.started).as_secs_f64();
         let share = done as f64 / self.steps.max(1) as f64;
-        let left = if share > 0.0 {
-            format!(", about {:.0} s left", elapsed * (1.0 - share) / share)
-        } else {
-            String::new()
-        };
+        let left = left.map_or_else(String::new, |s| format!(", about {} left", human(s)));
         eprintln!(
             "{}: step {done} of {} ({:.0} %), {elapsed:.0} s elapsed{left}",
             self.scene,
@@ -91,12 +136,13 @@ impl Reporter for Bars {
                 every: line_every(),
                 started: now,
                 last: Cell::new(now),
+                left: TimeLeft::default(),
             });
         }
         let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::hidden());
         bar.set_style(
             ProgressStyle::with_template(
-                "{prefix} [{bar:40}] {pos}/{len} steps, {elapsed} elapsed, eta {eta}",
+                "{prefix} [{bar:40}] {pos}/{len} steps, {elapsed} elapsed, {msg}",
             )
             .expect("valid template")
             .progress_chars("=> "),
@@ -106,6 +152,7 @@ impl Reporter for Bars {
             bar,
             started: Instant::now(),
             shown: Cell::new(false),
+            left: TimeLeft::default(),
         })
     }
 
@@ -116,6 +163,7 @@ impl Reporter for Bars {
                 bar: ProgressBar::hidden(),
                 started: Instant::now(),
                 shown: Cell::new(true),
+                left: TimeLeft::default(),
             });
         }
         let bar = ProgressBar::new_spinner();
@@ -125,6 +173,39 @@ impl Reporter for Bars {
             bar,
             started: Instant::now(),
             shown: Cell::new(true),
+            left: TimeLeft::default(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Steps that take 10 ms for a minute, then 1 s: a minute after the change, the time
+    /// left is read from the slow steps, not from the whole run's average.
+    #[test]
+    fn the_time_left_follows_the_recent_steps() {
+        let left = TimeLeft::default();
+        let start = Instant::now();
+        let mut now = start;
+        let mut done = 0;
+        let mut said = None;
+        for _ in 0..6000 {
+            now += Duration::from_millis(10);
+            done += 1;
+            said = left.after(now, done, 10_000);
+        }
+        assert!((said.unwrap() - 40.0).abs() < 1.0, "{said:?}");
+        for _ in 0..60 {
+            now += Duration::from_secs(1);
+            done += 1;
+            said = left.after(now, done, 10_000);
+        }
+        // 3940 steps left at 1 s each.
+        let s = said.unwrap();
+        assert!((s / 3940.0 - 1.0).abs() < 0.05, "{s}");
+        assert_eq!(human(65.0), "1 min 5 s");
+        assert_eq!(human(7300.0), "2 h 1 min");
     }
 }

@@ -2,6 +2,7 @@
 //! integrator, with what its step risks.
 
 use crate::SetupArgs;
+use crate::advice::{large_step_promises, newton_cost, recommend};
 use crate::risks::{large_step_advice, thin_surfaces, tunnelling, warn_if_unstable};
 use anyhow::Result;
 use hooke::source;
@@ -53,42 +54,56 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
         println!("  {:<11} {line}{mark}", integrator.name());
     }
     let dt = sim.dt();
+    let advice = recommend(&scene, &estimate, dt);
+    println!(
+        "recommended at dt = {} s: {} ({})",
+        Num(dt),
+        advice.integrator,
+        advice.why
+    );
     if let Some(advice) = large_step_advice(&scene, &estimate) {
         println!("{advice}");
     }
-    if sim.integrator().solves_contacts() {
-        let name = sim.integrator().name();
-        if sim.integrator() == Integrator::Vbd {
+    // What the scene's integrator promises, and the recommended one's when it is another
+    // large step.
+    let mut promised = vec![sim.integrator()];
+    if advice.integrator != sim.integrator() && advice.integrator.solves_contacts() {
+        promised.push(advice.integrator);
+    }
+    for integrator in promised.into_iter().filter(|i| i.solves_contacts()) {
+        if integrator == Integrator::Vbd {
             for message in crate::risks::volumetric_bodies(&scene) {
                 println!("warning: {message}");
             }
         }
-        println!(
-            "{name} guarantees: stability at any dt; no surface crosses a still collider or \
-             another surface at any dt (every update is bounded, docs/physics.md §4.1); a \
-             moving collider or keyed pins are followed in parts of the step, down to dt/{}, \
-             and where a pinned or squeezed particle lies in a moving collider's path, where \
-             no integrator can keep the bound, the run warns at the step it happens; a run \
-             whose energy grows by more than a hundredth of its scale beyond the work done on \
-             it stops as diverged",
-            hooke_core::MOST_PARTS
-        );
-        let rule = sim.workspace().stop_rule_of(sim.integrator());
-        let update = if sim.integrator() == Integrator::Newton {
+        if integrator == Integrator::Newton
+            && let Some(cost) = newton_cost(&scene)
+        {
+            println!("warning: {cost}");
+        }
+        for line in large_step_promises(&scene, integrator) {
+            println!("{line}");
+        }
+        let rule = sim.workspace().stop_rule_of(integrator);
+        let update = if integrator == Integrator::Newton {
             "Newton step (before its line search)"
         } else {
-            "iteration"
+            "iteration (and what the iterations' rate of contraction says is still to go)"
         };
         println!(
-            "{name} does not guarantee: a solved step. A step ends when its last {update} \
+            "{} does not guarantee: a solved step. A step ends when its last {update} \
              moved no particle faster than {} m/s (--tolerance), or after {} iterations \
              (--iterations) whether or not it got there; `hooke bench scene` counts the steps \
              at the budget and the final update's speed. Contacts are inelastic (cr has no \
              effect), and a particle slides along a mesh or cylinder collider at most about \
              0.9 of its gap per detection (along the ground and planes freely), so fast \
              sliding over a tabletop at large steps is held back",
-            rule.tolerance, rule.iterations
+            integrator.name(),
+            rule.tolerance,
+            rule.iterations
         );
+    }
+    if sim.integrator().solves_contacts() {
         return Ok(ExitCode::SUCCESS);
     }
     if sim.integrator() == Integrator::Implicit {

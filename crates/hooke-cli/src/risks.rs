@@ -123,6 +123,11 @@ fn collider_speed(scene: &Scene, k: usize) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The fastest a particle can move, m/s (see [`fastest`]).
+pub(crate) fn fastest_speed(scene: &Scene) -> f64 {
+    fastest(scene).0
+}
+
 /// The fastest a particle can move, m/s: the larger of the fastest now and a free fall from
 /// the highest particle to the ground (or the lowest particle); and that fall's height.
 fn fastest(scene: &Scene) -> (f64, f64) {

@@ -1,6 +1,7 @@
 //! `hooke run`: simulate a scene and write what was asked (trajectory, frames, GIF, export).
 
 use crate::RunArgs;
+use crate::advice::warn_if_other_large_step;
 use crate::risks::{warn_if_tunnelling, warn_if_unstable};
 use anyhow::Result;
 use hooke::export::Target;
@@ -79,8 +80,9 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         view.range = Some(range);
     }
     let mut scene = source::build_prepared(source, &args.scene)?;
-    warn_if_unstable(&scene);
+    let estimate = warn_if_unstable(&scene);
     warn_if_tunnelling(&scene);
+    warn_if_other_large_step(&scene, &estimate);
     let every = scene.every;
     let dt = scene.simulation.dt();
     if args.summary {

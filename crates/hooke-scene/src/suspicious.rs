@@ -81,6 +81,8 @@ impl Scene {
                 ));
             }
         }
+        said.extend(self.pins_into_colliders());
+        said.extend(self.ignored_stop_rule());
         for moved in &self.pushed_out {
             said.push(format!(
                 "{} particle{} started inside collider[{}] ({}) or nearer it than their \
@@ -134,6 +136,74 @@ impl Scene {
         }
         said.extend(self.overlapping_bodies());
         said
+    }
+
+    /// Keyed pins that their keys take into a still collider: they drag their body in after
+    /// them, which no integrator prevents (a pin is moved by its keys, not by contacts).
+    /// Sampled at every key and at 64 times between two keys.
+    fn pins_into_colliders(&self) -> Vec<String> {
+        const SAMPLES: usize = 64;
+        let model = self.simulation.model();
+        let mut said = Vec::new();
+        for motion in &model.pin_motions {
+            let keys = motion.keys.keys();
+            let times: Vec<f64> = keys
+                .windows(2)
+                .flat_map(|w| {
+                    (0..SAMPLES)
+                        .map(move |k| w[0].t + (w[1].t - w[0].t) * k as f64 / SAMPLES as f64)
+                })
+                .chain(keys.last().map(|k| k.t))
+                .filter(|t| *t >= 0.0)
+                .collect();
+            'colliders: for (k, slot) in model.colliders.iter().enumerate() {
+                if slot.shape.is_moving() {
+                    continue;
+                }
+                for &t in &times {
+                    if let Some((i, _)) = motion.positions(t).find(|(_, x)| slot.shape.inside(x)) {
+                        let body = self
+                            .bodies
+                            .iter()
+                            .find(|b| b.range.contains(&i))
+                            .map_or(String::new(), |b| format!(" of body '{}'", b.name));
+                        said.push(format!(
+                            "the keyed pins{body} enter collider[{k}] ({}) by t = {} s: a pin \
+                             follows its keys whatever is in its way, and drags its body into \
+                             the collider after it under every integrator; key the pins clear \
+                             of it",
+                            slot.shape.name(),
+                            hooke_core::Approx(t)
+                        ));
+                        continue 'colliders;
+                    }
+                }
+            }
+        }
+        said
+    }
+
+    /// A stopping rule (`tolerance`, `iterations`) given to an integrator that takes none:
+    /// only `vbd` and `newton` iterate to one.
+    fn ignored_stop_rule(&self) -> Vec<String> {
+        let sim = &self.spec.simulation;
+        let integrator = self.simulation.integrator();
+        if integrator.solves_contacts() {
+            return Vec::new();
+        }
+        [
+            ("tolerance", sim.tolerance.is_some()),
+            ("iterations", sim.iterations.is_some()),
+        ]
+        .into_iter()
+        .filter(|(_, given)| *given)
+        .map(|(key, _)| {
+            format!(
+                "{key} (--{key}) is block descent's and Newton's stopping rule; {integrator} \
+                 takes none, so it has no effect here (use --integrator vbd or newton)"
+            )
+        })
+        .collect()
     }
 
     /// Pairs of bodies that start through each other, or nearer than the sum of their
