@@ -333,25 +333,70 @@ fn a_frame_folder_is_held_by_one_run_at_a_time() {
 }
 
 /// Issue 54: a folder of someone else's frames (a video's, extracted as `frame-%05d.png`)
-/// is not Hooke's to empty: a run into it is refused, naming a file, and nothing in it is
-/// touched; a folder export likewise.
+/// is not Hooke's to empty: a run that would write those names is refused, naming a file,
+/// and nothing in it is touched. Issue 60: a folder export of another kind keeps them and
+/// says so; a planted or empty marker takes nothing; in a folder Hooke did mark, a file it
+/// did not write (or one it wrote and a person changed) stays, and the run says so.
 #[test]
 fn a_users_frames_are_never_removed() {
     let dir = scratch("users-frames");
-    for (folder, args) in [
-        ("f2", vec!["--frames", "f2"]),
-        ("e2", vec!["--export", "e2/", "--format", "ply"]),
-    ] {
-        std::fs::create_dir_all(dir.join(folder)).unwrap();
-        let mine = dir.join(folder).join("frame-00500.png");
-        std::fs::write(&mine, "mine").unwrap();
-        let mut all = vec!["run", "chain", "--steps", "100", "--every", "10"];
-        all.extend(args);
-        let out = hooke(&all, &dir);
-        assert_eq!(out.status.code(), Some(1), "{all:?}: {}", stderr(&out));
-        assert!(stderr(&out).contains("frame-00500.png"), "{}", stderr(&out));
-        assert_eq!(std::fs::read_to_string(&mine).unwrap(), "mine");
-        assert_eq!(file_names(&dir.join(folder)), ["frame-00500.png"]);
+    let chain = ["run", "chain", "--steps", "100", "--every", "10"];
+    let run = |extra: &[&str]| {
+        let mut all = chain.to_vec();
+        all.extend(extra);
+        hooke(&all, &dir)
+    };
+    std::fs::create_dir_all(dir.join("f2")).unwrap();
+    let mine = dir.join("f2/frame-00500.png");
+    std::fs::write(&mine, "mine").unwrap();
+    let out = run(&["--frames", "f2"]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("frame-00500.png"), "{}", stderr(&out));
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "mine");
+    assert_eq!(file_names(&dir.join("f2")), ["frame-00500.png"]);
+
+    // PLY frames into the same folder write none of its names: it is kept, and said.
+    let out = run(&["--export", "f2/", "--format", "ply"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("kept a file named like frames"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "mine");
+    // The next PLY run replaces exactly the frames the first wrote.
+    let out = run(&["--export", "f2/", "--format", "ply"]);
+    assert!(
+        stderr(&out).contains("removed 11 frames"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "mine");
+
+    // A frame of this run's kind that Hooke recorded, then a person edited: not Hooke's.
+    let edited = dir.join("f2/frame-00003.ply");
+    std::fs::write(&edited, "edited").unwrap();
+    let out = run(&["--export", "f2/", "--format", "ply"]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("frame-00003.ply"), "{}", stderr(&out));
+    assert_eq!(std::fs::read_to_string(&edited).unwrap(), "edited");
+
+    // A marker Hooke did not write, empty or not, takes nothing.
+    for planted in ["", "hooke: anything at all\n"] {
+        std::fs::create_dir_all(dir.join("f3")).unwrap();
+        std::fs::write(dir.join("f3/.hooke-frames"), planted).unwrap();
+        std::fs::write(dir.join("f3/frame-00000.png"), "mine").unwrap();
+        let out = run(&["--frames", "f3"]);
+        assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+        assert!(stderr(&out).contains(".hooke-frames"), "{}", stderr(&out));
+        assert_eq!(
+            std::fs::read_to_string(dir.join("f3/frame-00000.png")).unwrap(),
+            "mine"
+        );
+        assert_eq!(
+            std::fs::read_to_string(dir.join("f3/.hooke-frames")).unwrap(),
+            planted
+        );
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

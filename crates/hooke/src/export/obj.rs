@@ -135,6 +135,7 @@ impl crate::Sink for ObjExport {
         write_frame(file.writer(), frame, scene, colliders)
             .with_context(|| format!("cannot write {}", path.display()))?;
         file.commit()?;
+        crate::output::record_frame(&path, "--export")?;
         self.frames += 1;
         Ok(())
     }

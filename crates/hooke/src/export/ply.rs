@@ -183,6 +183,7 @@ impl crate::Sink for PlyExport {
         self.write(file.writer(), frame, scene)
             .with_context(|| format!("cannot write {}", path.display()))?;
         file.commit()?;
+        crate::output::record_frame(&path, "--export")?;
         self.frames += 1;
         Ok(())
     }

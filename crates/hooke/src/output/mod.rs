@@ -8,9 +8,12 @@ pub mod claims;
 pub mod destination;
 pub mod file;
 pub mod lock;
+pub(crate) mod marker;
 pub mod named;
 
 pub use file::{OutputFile, remove_pending, write_atomic, write_named};
+pub use marker::FRAMES_MARKER;
+pub(crate) use marker::record_frame;
 pub use named::check_named;
 
 use crate::error::{Context, Result, bail_output};
@@ -107,15 +110,6 @@ pub fn check_output_folder(dir: &Path, flag: &str) -> Result<()> {
     Ok(())
 }
 
-/// The file that says a folder holds Hooke's frames: written when Hooke first takes a
-/// folder for frames, so that a later run may remove that run's frames (and only in a
-/// folder that carries it).
-pub const FRAMES_MARKER: &str = ".hooke-frames";
-
-/// What the marker holds.
-const FRAMES_MARKER_TEXT: &str = "hooke: this folder holds frames written by hooke \
-(frame-NNNNN.png, .ply, .obj); a later run into it replaces them\n";
-
 /// Creates folder `dir` (given with option `flag`) and any missing folders above it; when
 /// that fails because something on the way is not a folder (a file, a link to nothing),
 /// says which.
@@ -157,38 +151,57 @@ pub fn create_folder(dir: &Path, flag: &str) -> Result<()> {
 /// exactly this run's frames. Returns the folder's lock, held while the frames are written,
 /// and how many frames were removed.
 ///
-/// Only a folder marked as Hooke's ([`FRAMES_MARKER`]) has frames removed: a folder without
-/// the marker is taken (and marked) only when nothing in it is named like a frame, so a
-/// file Hooke did not write — a video's frames extracted as `frame-%05d.png` — is never
-/// removed or replaced; the run is refused instead, naming it.
+/// Only frames that the folder's marker ([`FRAMES_MARKER`], `marker.rs`) records as written
+/// by Hooke, and that are unchanged since, are removed. A file named like a frame of this
+/// run's kind that Hooke did not write (a video's frames extracted as `frame-%05d.png`, a
+/// frame a person edited) would be replaced by this run's frame: the run is refused, naming
+/// it, and the folder is left as it was. One of another kind stays, and the run says so. A
+/// file under the marker's name that Hooke did not write is never replaced: the run is
+/// refused.
 pub fn prepare_frame_folder(dir: &Path, flag: &str, ext: &str) -> Result<(FolderLock, usize)> {
     check_output_folder(dir, flag)?;
     create_folder(dir, flag)?;
     let lock = FolderLock::take(dir, flag)?;
-    let marker = dir.join(FRAMES_MARKER);
-    check_named(&marker, flag)?;
-    let marked = std::fs::symlink_metadata(&marker).is_ok();
+    let record = match marker::read(dir, flag)? {
+        marker::Marker::Hookes(record) => record,
+        marker::Marker::Absent => marker::Record::default(),
+        marker::Marker::Foreign(first) => bail_output!(
+            "{flag} {}: its {FRAMES_MARKER} file was not written by hooke (it begins {first:?}), \
+             so nothing in this folder is taken for hooke's; remove that file, or choose a new \
+             or empty folder",
+            dir.display()
+        ),
+    };
     let entries =
         std::fs::read_dir(dir).with_context(|| format!("{flag} {}: cannot read", dir.display()))?;
     // Every stale frame is looked at before any is removed: a link, a second name or a
     // device under a frame's name refuses the run and leaves the folder as it was.
     let mut stale = Vec::new();
     let mut foreign = Vec::new();
+    let mut kept = Vec::new();
     for entry in entries.flatten() {
         let name = entry.file_name().to_string_lossy().into_owned();
-        if !marked && is_any_frame_name(&name) {
-            foreign.push(name);
-        } else if is_frame_name(&name, ext) {
+        if !is_any_frame_name(&name) {
+            continue;
+        }
+        let ours = std::fs::symlink_metadata(entry.path())
+            .is_ok_and(|meta| named::is_plain(&meta) && record.wrote(&name, &meta));
+        if ours && is_frame_name(&name, ext) {
             named::check_named(&entry.path(), flag)?;
             stale.push(entry.path());
+        } else if is_frame_name(&name, ext) {
+            foreign.push(name);
+        } else if !ours {
+            kept.push(name);
         }
     }
     if !foreign.is_empty() {
         foreign.sort();
         bail_output!(
-            "{flag} {}: holds {} named like hooke's frames ({}{}) but is not a folder hooke \
-             wrote frames into (it has no {FRAMES_MARKER} marker), so they are not hooke's to \
-             replace; choose a new or empty folder, or move them away",
+            "{flag} {}: holds {} named like this run's frames ({}{}) that hooke did not write \
+             (or that changed since it wrote them: the folder's {FRAMES_MARKER} does not record \
+             them), so they are not hooke's to replace; choose a new or empty folder, or move \
+             them away",
             dir.display(),
             if foreign.len() == 1 {
                 "a file".to_string()
@@ -199,9 +212,26 @@ pub fn prepare_frame_folder(dir: &Path, flag: &str, ext: &str) -> Result<(Folder
             if foreign.len() > 1 { ", …" } else { "" }
         );
     }
-    if !marked {
-        write_named(&marker, flag, FRAMES_MARKER_TEXT.as_bytes())?;
+    if !kept.is_empty() {
+        kept.sort();
+        eprintln!(
+            "{flag} {}: kept {} named like frames that hooke did not write ({}{})",
+            dir.display(),
+            if kept.len() == 1 {
+                "a file".to_string()
+            } else {
+                format!("{} files", kept.len())
+            },
+            kept[0],
+            if kept.len() > 1 { ", …" } else { "" }
+        );
     }
+    // The marker keeps the records of the frames of other kinds still there (a folder shared
+    // by --frames and --export); this run's kind is recorded again as it is written.
+    let text = record.text(|name| {
+        !is_frame_name(name, ext) && std::fs::symlink_metadata(dir.join(name)).is_ok()
+    });
+    write_named(&dir.join(FRAMES_MARKER), flag, text.as_bytes())?;
     for path in &stale {
         std::fs::remove_file(path)
             .with_context(|| format!("{flag}: cannot remove the stale frame {}", path.display()))?;
@@ -258,21 +288,53 @@ mod tests {
         let e = prepare_frame_folder(&dir, "--frames", "png").unwrap_err();
         assert!(format!("{e:#}").contains("frame-00500.png"), "{e:#}");
         assert!(format!("{e:#}").contains(FRAMES_MARKER), "{e:#}");
-        // A frame of another format is a user's file too.
-        let e = prepare_frame_folder(&dir, "--export", "ply").unwrap_err();
-        assert!(format!("{e:#}").contains("frame-00500.png"), "{e:#}");
-        assert_eq!(std::fs::read(&mine).unwrap(), b"mine");
         assert!(!dir.join(FRAMES_MARKER).exists());
-        // A folder hooke marked is hooke's: its frames are replaced by the next run.
+        // A frame of another format is a user's file too: this run writes none of its
+        // names, so it is kept (and said) while the run takes the folder.
+        let (lock, removed) = prepare_frame_folder(&dir, "--export", "ply").unwrap();
+        assert_eq!(removed, 0);
+        assert_eq!(std::fs::read(&mine).unwrap(), b"mine");
+        drop(lock);
+        // A folder hooke marked holds hooke's frames: those it recorded are replaced by the
+        // next run.
         std::fs::remove_file(&mine).unwrap();
         std::fs::write(dir.join("notes.txt"), b"kept").unwrap();
         let (lock, removed) = prepare_frame_folder(&dir, "--frames", "png").unwrap();
         assert_eq!(removed, 0);
         assert!(dir.join(FRAMES_MARKER).exists());
-        std::fs::write(dir.join("frame-00000.png"), b"a frame").unwrap();
+        let written = dir.join("frame-00000.png");
+        write_named(&written, "--frames", b"a frame").unwrap();
+        record_frame(&written, "--frames").unwrap();
         drop(lock);
         let (lock, removed) = prepare_frame_folder(&dir, "--frames", "png").unwrap();
         assert_eq!(removed, 1);
+        // A file a person put there under a frame's name is not hooke's: the run is refused
+        // and the file stays, though the folder is marked.
+        std::fs::write(dir.join("frame-00001.png"), b"mine").unwrap();
+        drop(lock);
+        let e = prepare_frame_folder(&dir, "--frames", "png").unwrap_err();
+        assert!(format!("{e:#}").contains("frame-00001.png"), "{e:#}");
+        assert_eq!(std::fs::read(dir.join("frame-00001.png")).unwrap(), b"mine");
+        // Nor is a recorded frame a person changed since.
+        std::fs::remove_file(dir.join("frame-00001.png")).unwrap();
+        let (lock, _) = prepare_frame_folder(&dir, "--frames", "png").unwrap();
+        write_named(&written, "--frames", b"a frame").unwrap();
+        record_frame(&written, "--frames").unwrap();
+        std::fs::write(&written, b"edited by hand").unwrap();
+        drop(lock);
+        assert!(prepare_frame_folder(&dir, "--frames", "png").is_err());
+        assert_eq!(std::fs::read(&written).unwrap(), b"edited by hand");
+        std::fs::remove_file(&written).unwrap();
+        // A marker hooke did not write (empty, planted) takes nothing.
+        std::fs::write(dir.join(FRAMES_MARKER), b"").unwrap();
+        std::fs::write(dir.join("frame-00002.ply"), b"mine").unwrap();
+        let e = prepare_frame_folder(&dir, "--frames", "png").unwrap_err();
+        assert!(format!("{e:#}").contains(FRAMES_MARKER), "{e:#}");
+        assert_eq!(std::fs::read(dir.join("frame-00002.ply")).unwrap(), b"mine");
+        std::fs::write(dir.join(FRAMES_MARKER), marker::HEADER).unwrap();
+        let (lock, removed) = prepare_frame_folder(&dir, "--frames", "png").unwrap();
+        assert_eq!(removed, 0);
+        assert_eq!(std::fs::read(dir.join("frame-00002.ply")).unwrap(), b"mine");
         assert_eq!(std::fs::read(dir.join("notes.txt")).unwrap(), b"kept");
         drop(lock);
         std::fs::remove_dir_all(&dir).unwrap();
