@@ -128,12 +128,7 @@ fn animate(
         ..view.clone()
     };
     let path = out.join(animation_name(name));
-    let mut gif = GifWriter::create_named(
-        &path,
-        "--out",
-        small.size,
-        (interval * 1000.0).round() as u32,
-    )?;
+    let mut gif = GifWriter::create_named(&path, "--out", small.size, interval * 1000.0)?;
     let result = drive(&mut scene, |_, scene| {
         gif.frame(small.pixels(scene, camera))
     });

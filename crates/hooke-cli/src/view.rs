@@ -473,7 +473,7 @@ pub fn run(args: &ViewArgs) -> Result<ExitCode> {
             // A quantity's colours each frame on its own range (rounded up), with its legend.
             let by = viewer.color;
             let shown = by.values(&viewer.scene).map(|values| {
-                let range = by.default_range(&values);
+                let range = by.default_range(&viewer.scene, &values);
                 (by.colors(&values, range), range)
             });
             let tint = shown.as_ref().map(|(colors, _)| colors.as_slice());

@@ -168,13 +168,48 @@ fn help_texts() -> Vec<(String, String)> {
     texts
 }
 
+/// The repository's files ending in one of `exts`: those git lists (tracked, and new ones it
+/// does not ignore) in a checkout, so that nothing another process makes or removes in the
+/// clone while the test reads it — a second test run's build output or scratch, an editor's
+/// swap file — is read half-written or vanishes between the listing and the check; a walk
+/// of the folder where git cannot say.
+fn repository_files(root: &Path, exts: &[&str]) -> Vec<PathBuf> {
+    let listed = Command::new("git")
+        .args([
+            "ls-files",
+            "-z",
+            "--cached",
+            "--others",
+            "--exclude-standard",
+        ])
+        .current_dir(root)
+        .output()
+        .ok()
+        .filter(|o| o.status.success());
+    let Some(listed) = listed else {
+        let mut out = Vec::new();
+        for ext in exts {
+            files(root, ext, &mut out);
+        }
+        return out;
+    };
+    String::from_utf8_lossy(&listed.stdout)
+        .split('\0')
+        .filter(|name| {
+            !name.is_empty()
+                && Path::new(name)
+                    .extension()
+                    .is_some_and(|e| exts.iter().any(|x| e == *x))
+        })
+        .map(|name| root.join(name))
+        .filter(|path| path.is_file())
+        .collect()
+}
+
 #[test]
 fn every_mentioned_repository_path_exists() {
     let root = root();
-    let mut sources = Vec::new();
-    files(&root, "md", &mut sources);
-    files(&root, "rs", &mut sources);
-    files(&root, "toml", &mut sources);
+    let sources = repository_files(&root, &["md", "rs", "toml"]);
     assert!(sources.len() > 50, "found only {} files", sources.len());
     let mut missing = Vec::new();
     let mut checked = 0;
@@ -232,8 +267,7 @@ fn the_path_finder_sees_what_it_should() {
 #[test]
 fn every_rust_source_opens_with_a_module_comment() {
     let root = root();
-    let mut sources = Vec::new();
-    files(&root, "rs", &mut sources);
+    let sources = repository_files(&root, &["rs"]);
     assert!(sources.len() > 50, "found only {} files", sources.len());
     let silent: Vec<String> = sources
         .iter()

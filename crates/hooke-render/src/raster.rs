@@ -152,7 +152,11 @@ impl Renderer {
             points: &self.points,
             shading: Shading::new(camera, options.ambient),
             shadow: if options.shadows {
-                ShadowMap::new(list, camera.key_light())
+                ShadowMap::new(
+                    list,
+                    camera.key_light(),
+                    metres_per_pixel(camera, options.height),
+                )
             } else {
                 None
             },
@@ -215,6 +219,12 @@ impl Renderer {
         }
         out
     }
+}
+
+/// The width of an output pixel at the camera's target, metres: what a line or point drawn
+/// so many pixels wide spans there (its shadow's width).
+fn metres_per_pixel(camera: &Camera, height: u32) -> f64 {
+    2.0 * camera.distance * (0.5 * camera.fov_y.to_radians()).tan() / f64::from(height.max(1))
 }
 
 #[cfg(test)]

@@ -51,9 +51,11 @@ pub(crate) struct ShadowMap {
 }
 
 impl ShadowMap {
-    /// The map of `list`'s triangles under a light from direction `light` (unit, towards the
-    /// light); `None` when the list has no triangle.
-    pub(crate) fn new(list: &DrawList, light: Vector3<f64>) -> Option<Self> {
+    /// The map of `list`'s triangles, lines and points under a light from direction `light`
+    /// (unit, towards the light); `None` when the list has none. A line or point casts the
+    /// shadow of a strip or square as wide as it is drawn, `metres_per_pixel` the width of
+    /// a pixel at the camera's target (a chain's shadow is its links' width).
+    pub(crate) fn new(list: &DrawList, light: Vector3<f64>, metres_per_pixel: f64) -> Option<Self> {
         let l = light.normalize();
         let helper = if l.x.abs() < 0.9 {
             Vector3::x()
@@ -74,6 +76,13 @@ impl ShadowMap {
             }
         };
         for_each_triangle(list, |p| p.into_iter().for_each(&mut take));
+        for line in &list.lines {
+            take(line.a);
+            take(line.b);
+        }
+        for point in &list.points {
+            take(point.p);
+        }
         if corners == 0 {
             return None;
         }
@@ -110,6 +119,38 @@ impl ShadowMap {
                 .iter()
                 .map(|t| t.p.map(|q| map.light_space(&q))),
         );
+        // Lines and points as quads across the light: half their drawn width each side, and
+        // at least half a texel, so that a thin chain still shades the texels it crosses.
+        let half = |pixels: f32| (0.5 * f64::from(pixels) * metres_per_pixel / map.texel).max(0.5);
+        for line in &list.lines {
+            let (a, b) = (map.light_space(&line.a), map.light_space(&line.b));
+            let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+            let len = (dx * dx + dy * dy).sqrt();
+            let w = half(line.width);
+            // Across the line in the map; a line along the light is a square.
+            let (nx, ny) = if len > 1e-12 {
+                (-dy / len * w, dx / len * w)
+            } else {
+                (w, 0.0)
+            };
+            let (ex, ey) = if len > 1e-12 { (0.0, 0.0) } else { (0.0, w) };
+            let p = |c: (f64, f64, f64), sx: f64, sy: f64| (c.0 + sx, c.1 + sy, c.2);
+            let corners = [
+                p(a, nx - ex, ny - ey),
+                p(b, nx + ex, ny + ey),
+                p(b, -nx + ex, -ny + ey),
+                p(a, -nx - ex, -ny - ey),
+            ];
+            triangles.push([corners[0], corners[1], corners[2]]);
+            triangles.push([corners[0], corners[2], corners[3]]);
+        }
+        for point in &list.points {
+            let c = map.light_space(&point.p);
+            let r = half(2.0 * point.radius);
+            let q = |sx: f64, sy: f64| (c.0 + sx * r, c.1 + sy * r, c.2);
+            triangles.push([q(-1.0, -1.0), q(1.0, -1.0), q(1.0, 1.0)]);
+            triangles.push([q(-1.0, -1.0), q(1.0, 1.0), q(-1.0, 1.0)]);
+        }
         // Each band's triangles, in list order: a band reads only those that reach it.
         let mut bands: Vec<Vec<u32>> = vec![Vec::new(); SIDE.div_ceil(BAND)];
         for (k, t) in triangles.iter().enumerate() {
@@ -306,7 +347,7 @@ mod tests {
     fn ground_under_a_slab_is_shadowed_and_darker_where_the_slab_is_near() {
         let up = Vector3::y();
         let below = |y: f64| {
-            let map = ShadowMap::new(&slab(y), up).unwrap();
+            let map = ShadowMap::new(&slab(y), up, 0.01).unwrap();
             map.light(&Vector3::zeros(), &up)
         };
         let (near, far) = (below(0.04), below(1.0));
@@ -314,7 +355,24 @@ mod tests {
         assert!(near.1 < 0.75, "ambient kept 4 cm under: {}", near.1);
         assert!(far.1 > 0.99, "ambient kept 1 m under: {}", far.1);
         // Beside the slab, in the light.
-        let map = ShadowMap::new(&slab(0.01), up).unwrap();
+        let map = ShadowMap::new(&slab(0.01), up, 0.01).unwrap();
         assert_eq!(map.light(&Vector3::new(1.5, 0.0, 0.0), &up), (1.0, 1.0));
+    }
+
+    /// A chain drawn as lines 4 pixels wide (4 cm at 1 cm a pixel), 0.5 m over the ground,
+    /// shadows the ground under it and not 10 cm beside it.
+    #[test]
+    fn a_line_casts_a_shadow_as_wide_as_it_is_drawn() {
+        let up = Vector3::y();
+        let mut list = slab(-1.0);
+        list.lines.push(crate::draw_list::Line {
+            a: Vector3::new(-0.5, 0.5, 0.0),
+            b: Vector3::new(0.5, 0.5, 0.0),
+            color: [0.5; 3],
+            width: 4.0,
+        });
+        let map = ShadowMap::new(&list, up, 0.01).unwrap();
+        assert_eq!(map.light(&Vector3::new(0.2, 0.0, 0.0), &up).0, 0.0);
+        assert_eq!(map.light(&Vector3::new(0.2, 0.0, 0.1), &up).0, 1.0);
     }
 }

@@ -32,7 +32,7 @@ pub fn animation_range(mut scene: Scene, by: ColorBy) -> (f64, f64) {
         done += n;
         top = top.max(largest(&scene));
     }
-    by.default_range(&[top])
+    by.default_range(&scene, &[top])
 }
 
 /// Writes frames of a run as numbered PNGs and optionally a GIF, each as it comes.
@@ -71,10 +71,7 @@ impl Frames {
             }
         }
         let gif = match &gif {
-            Some(path) => {
-                let frame_ms = (frame_seconds * 1000.0).round().clamp(10.0, 655_350.0) as u32;
-                Some(GifWriter::create(path, view.size, frame_ms)?)
-            }
+            Some(path) => Some(GifWriter::create(path, view.size, frame_seconds * 1000.0)?),
             None => None,
         };
         Ok(Some(Self {
@@ -97,7 +94,9 @@ impl crate::Sink for Frames {
         });
         let image = self.view.pixels(scene, &camera);
         if let Some(d) = &self.dir {
-            write_png_named(&d.join(frame_name(frame, "png")), "--frames", &image)?;
+            let path = d.join(frame_name(frame, "png"));
+            write_png_named(&path, "--frames", &image)?;
+            crate::output::record_frame(&path, "--frames")?;
         }
         if let Some(g) = self.gif.as_mut() {
             g.frame(image)?;

@@ -145,7 +145,7 @@ impl View {
         let values = self.color.values(scene)?;
         let range = self
             .range
-            .unwrap_or_else(|| self.color.default_range(&values));
+            .unwrap_or_else(|| self.color.default_range(scene, &values));
         Some((values, range))
     }
 
@@ -202,29 +202,41 @@ pub(crate) fn png_bytes(path: &Path, image: &RgbaImage) -> Result<Vec<u8>> {
 
 /// A looping GIF animation written frame by frame; it appears at its path only on
 /// [`GifWriter::finish`], and a writer dropped unfinished leaves nothing behind.
+///
+/// GIF counts delays in hundredths of a second, and viewers show a frame of less than two
+/// for a tenth of a second. So the animation plays in real time either way: frames at
+/// least two hundredths apart are each shown from their own time rounded to the hundredth
+/// (1/30 s frames for 3, 4 and 3), and closer ones are shown at 50 a second, each slot of
+/// two hundredths taking the frame whose time is nearest it (60 Hz frames: five of every
+/// six).
 pub struct GifWriter {
     path: PathBuf,
     encoder: gif::Encoder<OutputFile>,
     size: (u16, u16),
-    /// Frame delay, hundredths of a second (GIF's unit).
-    delay: u16,
+    /// Simulated time between frames, hundredths of a second.
+    period: f64,
+    /// The next slot of [`LEAST_DELAY`] to fill, when frames come faster than slots.
+    slot: u64,
     frames: u64,
 }
 
+/// The least delay viewers honour, hundredths of a second.
+const LEAST_DELAY: u64 = 2;
+
 impl GifWriter {
-    /// Starts a GIF of `size` pixels showing each frame for `frame_ms` milliseconds
-    /// (rounded to GIF's 10 ms, at least 20 ms: viewers slow faster frames down).
-    pub fn create(path: &Path, size: (u32, u32), frame_ms: u32) -> Result<Self> {
+    /// Starts a GIF of `size` pixels whose frames are `frame_ms` milliseconds of
+    /// simulated time apart.
+    pub fn create(path: &Path, size: (u32, u32), frame_ms: f64) -> Result<Self> {
         Self::start(OutputFile::create(path)?, path, size, frame_ms)
     }
 
     /// As [`GifWriter::create`], at `path`, a name hooke chose inside a folder it writes
     /// (given with option `flag`; see [`crate::output::named`]).
-    pub fn create_named(path: &Path, flag: &str, size: (u32, u32), frame_ms: u32) -> Result<Self> {
+    pub fn create_named(path: &Path, flag: &str, size: (u32, u32), frame_ms: f64) -> Result<Self> {
         Self::start(OutputFile::create_named(path, flag)?, path, size, frame_ms)
     }
 
-    fn start(file: OutputFile, path: &Path, size: (u32, u32), frame_ms: u32) -> Result<Self> {
+    fn start(file: OutputFile, path: &Path, size: (u32, u32), frame_ms: f64) -> Result<Self> {
         let cannot = || format!("cannot write {}", path.display());
         let w = u16::try_from(size.0).with_context(cannot)?;
         let h = u16::try_from(size.1).with_context(cannot)?;
@@ -232,17 +244,37 @@ impl GifWriter {
         encoder
             .set_repeat(gif::Repeat::Infinite)
             .with_context(cannot)?;
-        let delay = (frame_ms.div_ceil(10)).clamp(2, u16::MAX as u32) as u16;
+        let period = if frame_ms.is_finite() && frame_ms > 0.0 {
+            (frame_ms / 10.0).min(u16::MAX as f64)
+        } else {
+            LEAST_DELAY as f64
+        };
         Ok(Self {
             path: path.to_path_buf(),
             encoder,
             size: (w, h),
-            delay,
+            period,
+            slot: 0,
             frames: 0,
         })
     }
 
-    /// Quantises and appends one frame of the GIF's size.
+    /// How long frame `k` is shown, hundredths of a second, or `None` when it is left out.
+    fn delay(&mut self, k: u64) -> Option<u16> {
+        let p = self.period;
+        if p >= LEAST_DELAY as f64 {
+            let at = |k: u64| (k as f64 * p).round() as u64;
+            return Some((at(k + 1) - at(k)).clamp(LEAST_DELAY, u16::MAX as u64) as u16);
+        }
+        // The frame nearest slot `j`'s time `2 j`.
+        let nearest = (self.slot as f64 * LEAST_DELAY as f64 / p).round() as u64;
+        (k == nearest).then(|| {
+            self.slot += 1;
+            LEAST_DELAY as u16
+        })
+    }
+
+    /// Quantises and appends one frame of the GIF's size (or leaves it out: see the type).
     pub fn frame(&mut self, mut image: RgbaImage) -> Result<()> {
         if image.dimensions() != (self.size.0 as u32, self.size.1 as u32) {
             crate::error::bail_output!(
@@ -251,13 +283,17 @@ impl GifWriter {
                 self.size
             );
         }
+        let k = self.frames;
+        self.frames += 1;
+        let Some(delay) = self.delay(k) else {
+            return Ok(());
+        };
         // Speed 10 as image's encoder uses: NeuQuant on a sample of the pixels.
         let mut frame = gif::Frame::from_rgba_speed(self.size.0, self.size.1, &mut image, 10);
-        frame.delay = self.delay;
+        frame.delay = delay;
         self.encoder
             .write_frame(&frame)
             .with_context(|| format!("cannot write {}", self.path.display()))?;
-        self.frames += 1;
         Ok(())
     }
 
@@ -266,7 +302,7 @@ impl GifWriter {
         &self.path
     }
 
-    /// Frames written so far.
+    /// Frames taken so far (those left out between two slots included).
     pub fn frames(&self) -> u64 {
         self.frames
     }
@@ -278,5 +314,42 @@ impl GifWriter {
             .into_inner()
             .with_context(|| format!("cannot write {}", self.path.display()))?;
         file.commit()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The delays a GIF of frames `frame_ms` apart gives its first `n` frames (zero: left
+    /// out).
+    fn delays(frame_ms: f64, n: u64) -> Vec<u16> {
+        let path =
+            std::env::temp_dir().join(format!("hooke-gif-{}-{frame_ms}.gif", std::process::id()));
+        let mut gif = GifWriter::create(&path, (4, 4), frame_ms).unwrap();
+        (0..n).map(|k| gif.delay(k).unwrap_or(0)).collect()
+    }
+
+    #[test]
+    fn an_animation_plays_in_real_time_and_no_frame_is_under_two_hundredths() {
+        for (ms, frames) in [
+            (1000.0 / 60.0, 60),
+            (1000.0 / 30.0, 30),
+            (40.0, 25),
+            (100.0, 10),
+            (1.0, 1000),
+        ] {
+            let d = delays(ms, frames);
+            let shown: u64 = d.iter().map(|&x| u64::from(x)).sum();
+            // One second of frames plays for one second, to a slot.
+            assert!(
+                (shown as i64 - 100).abs() <= 2,
+                "{ms} ms: {shown} cs: {d:?}"
+            );
+            assert!(d.iter().all(|&x| x == 0 || x >= 2), "{ms} ms: {d:?}");
+        }
+        // 60 Hz: five frames of every six, each two hundredths; 30 Hz: 3, 4, 3.
+        assert_eq!(delays(1000.0 / 60.0, 6), [2, 2, 2, 0, 2, 2]);
+        assert_eq!(delays(1000.0 / 30.0, 3), [3, 4, 3]);
     }
 }

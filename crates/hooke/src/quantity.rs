@@ -67,13 +67,20 @@ impl ColorBy {
         }
     }
 
-    /// The range a still shows `values` with when none is given: from 0 (strain: centred on
-    /// 0, symmetric) to the largest magnitude rounded up to 1, 2 or 5 times a power of ten.
-    pub fn default_range(self, values: &[f64]) -> (f64, f64) {
-        let largest = values
+    /// The range a still of `scene` shows `values` with when none is given: from 0 (strain:
+    /// centred on 0, symmetric) to the largest magnitude rounded up to 1, 2 or 5 times a
+    /// power of ten. A gap's range ends at ten contact thicknesses at most (and two at
+    /// least), so that the thickness, where contacts act, takes a tenth of the bar or more
+    /// rather than vanishing under its bottom label.
+    pub fn default_range(self, scene: &Scene, values: &[f64]) -> (f64, f64) {
+        let mut largest = values
             .iter()
             .filter(|v| v.is_finite())
             .fold(0.0f64, |m, v| m.max(v.abs()));
+        let thickness = largest_thickness(scene);
+        if self == Self::Gap && thickness > 0.0 {
+            largest = largest.min(10.0 * thickness).max(2.0 * thickness);
+        }
         let top = nice(largest);
         if self == Self::Strain {
             (-top, top)
@@ -84,11 +91,7 @@ impl ColorBy {
 
     /// The legend for `range`, with the contact thickness marked on a gap's.
     pub fn legend(self, scene: &Scene, range: (f64, f64)) -> Legend {
-        let thickness = scene
-            .bodies
-            .iter()
-            .map(|b| b.thickness)
-            .fold(0.0f64, f64::max);
+        let thickness = largest_thickness(scene);
         Legend {
             map: self.map(),
             range,
@@ -108,6 +111,15 @@ impl ColorBy {
             })
             .collect()
     }
+}
+
+/// The largest contact thickness of the scene's bodies, metres (0: none has one).
+fn largest_thickness(scene: &Scene) -> f64 {
+    scene
+        .bodies
+        .iter()
+        .map(|b| b.thickness)
+        .fold(0.0f64, f64::max)
 }
 
 /// The smallest of 1, 2, 5 times a power of ten at or above `x` (1e-9 for 0).
@@ -185,7 +197,23 @@ mod tests {
         assert_eq!(nice(1.3), 2.0);
         assert_eq!(nice(3.0), 5.0);
         assert_eq!(nice(0.012), 0.02);
-        assert_eq!(ColorBy::Strain.default_range(&[-0.3, 1.2]), (-2.0, 2.0));
-        assert_eq!(ColorBy::Speed.default_range(&[0.3, 4.2]), (0.0, 5.0));
+        let cloth = crate::source::build("cloth-table", &Default::default()).unwrap();
+        assert_eq!(
+            ColorBy::Strain.default_range(&cloth, &[-0.3, 1.2]),
+            (-2.0, 2.0)
+        );
+        assert_eq!(
+            ColorBy::Speed.default_range(&cloth, &[0.3, 4.2]),
+            (0.0, 5.0)
+        );
+        // A gap's range shows the 5 mm thickness: ten of them at most, two at least.
+        assert_eq!(
+            ColorBy::Gap.default_range(&cloth, &[0.001, 0.9]),
+            (0.0, 0.05)
+        );
+        assert_eq!(
+            ColorBy::Gap.default_range(&cloth, &[0.001, 0.004]),
+            (0.0, 0.01)
+        );
     }
 }
