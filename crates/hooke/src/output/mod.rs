@@ -196,34 +196,20 @@ pub fn prepare_frame_folder(dir: &Path, flag: &str, ext: &str) -> Result<(Folder
         }
     }
     if !foreign.is_empty() {
-        foreign.sort();
+        let (count, first) = some_files(&mut foreign);
         bail_output!(
-            "{flag} {}: holds {} named like this run's frames ({}{}) that hooke did not write \
-             (or that changed since it wrote them: the folder's {FRAMES_MARKER} does not record \
-             them), so they are not hooke's to replace; choose a new or empty folder, or move \
-             them away",
+            "{flag} {}: holds {count} named like this run's frames ({first}) that hooke did not \
+             write (or that changed since it wrote them: the folder's {FRAMES_MARKER} does not \
+             record them), so they are not hooke's to replace; choose a new or empty folder, or \
+             move them away",
             dir.display(),
-            if foreign.len() == 1 {
-                "a file".to_string()
-            } else {
-                format!("{} files", foreign.len())
-            },
-            foreign[0],
-            if foreign.len() > 1 { ", …" } else { "" }
         );
     }
     if !kept.is_empty() {
-        kept.sort();
+        let (count, first) = some_files(&mut kept);
         eprintln!(
-            "{flag} {}: kept {} named like frames that hooke did not write ({}{})",
+            "{flag} {}: kept {count} named like frames that hooke did not write ({first})",
             dir.display(),
-            if kept.len() == 1 {
-                "a file".to_string()
-            } else {
-                format!("{} files", kept.len())
-            },
-            kept[0],
-            if kept.len() > 1 { ", …" } else { "" }
         );
     }
     // The marker keeps the records of the frames of other kinds still there (a folder shared
@@ -240,6 +226,18 @@ pub fn prepare_frame_folder(dir: &Path, flag: &str, ext: &str) -> Result<(Folder
     // Probe that frames can be written.
     check_output_file(&dir.join(frame_name(0, ext)), flag, &[ext])?;
     Ok((lock, removed))
+}
+
+/// `names` sorted and said in short: `a file` or `N files`, and the first name (with `, …`
+/// when there are more).
+fn some_files(names: &mut [String]) -> (String, String) {
+    names.sort();
+    let count = match names.len() {
+        1 => "a file".to_string(),
+        n => format!("{n} files"),
+    };
+    let more = if names.len() > 1 { ", …" } else { "" };
+    (count, format!("{}{more}", names[0]))
 }
 
 /// `frame-00042.ext`.

@@ -80,7 +80,17 @@ pub fn write(dir: &Path, options: &Options) -> Result<Outcome> {
     // Again under the lock: another run may have written the folder meanwhile.
     folder::check(dir, &checked)?;
     let mut files = folder::Pending::default();
-    let total = 12 + 1 + 7 + checked.len() as u64 + 5 + 3 + 1;
+    // As many steps as ticks: two convergence sweeps per integrator, the closed forms, the
+    // energy runs (one per built-in), the scenes, the worlds, the three determinism runs,
+    // the speed.
+    let total = 2 * hooke_core::Integrator::ALL.len()
+        + 1
+        + hooke_scene::builtin::BUILTINS.len()
+        + checked.len()
+        + references::WORLDS.len()
+        + 3
+        + 1;
+    let total = total as u64;
     let bar = reporter().run("report", total);
     let mut done = 0;
     let mut tick = || {
