@@ -346,12 +346,13 @@ fn collider_power(model: &Model, p: &Particles) -> Vec<f64> {
         held[i] -= f;
         held[j] += f;
     }
+    let point = model.point_thickness();
     for (k, slot) in model.colliders.iter().enumerate() {
         if !slot.shape.is_moving() {
             continue;
         }
         for i in (0..p.len()).filter(|&i| p.inv_mass[i] != 0.0) {
-            let margin = model.margin(i).max(model.point_thickness());
+            let margin = model.margin(i).max(point);
             let mut normal = None;
             slot.shape
                 .contacts_within(&p.x[i], 2.0 * margin, &mut |c| normal = Some(c));
