@@ -8,9 +8,10 @@
 //! The total energy `E` is kinetic plus potential (springs, gravity, penalty springs), so
 //! gravity and the springs do no net work on it. What may raise it: the force field, the
 //! air, the attachments, keyframed pins (pins held still do no work) and moving colliders.
-//! The work of all but the colliders is summed from their power `Σ max(0, F·v)` sampled at
-//! each check, times the time since the last; a moving collider's is bounded instead, in
-//! the energy scale below. A run is runaway when
+//! Their work is summed by source from their power `Σ max(0, F·v)` sampled at each check,
+//! times the time since the last (a pin's or a moving collider's `F` is what holds its
+//! particles against their springs and weight); a moving collider's is also bounded in the
+//! energy scale below, for the bounces a sampled power misses. A run is runaway when
 //!
 //! ```text
 //! E − E(0) > 10 S + 2 W
@@ -137,7 +138,7 @@ impl EnergyWatch {
         } else {
             GROWTH * self.scale + 2.0 * self.supplied
         };
-        // Energy that fell, or stayed, came from nowhere: never a runaway. A non-finite
+        // Energy that fell or stayed is no energy from nowhere: never a runaway. A non-finite
         // state is the sanity check's to name; an allowance that is not a number (it never
         // should be) stops nothing.
         if e <= self.start || e - self.start <= allowed || !e.is_finite() || allowed.is_nan() {

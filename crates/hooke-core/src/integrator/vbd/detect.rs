@@ -44,6 +44,7 @@ const FELT: f64 = 2.0;
 pub(crate) const CONTACT_STIFFNESS: f64 = 1.0;
 /// Particles (or triangles, edges) per parallel chunk of the detection.
 const CHUNK: usize = 512;
+
 /// How near a primitive's nearest neighbour is, and its nearest neighbour whose contact is
 /// not felt (farther than [`FELT`] thicknesses), capped at the search's reach.
 #[derive(Clone, Copy, Debug)]
