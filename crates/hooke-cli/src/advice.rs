@@ -2,7 +2,7 @@
 //! scene's) integrator promises, body by body: a promise names the bodies it covers, and
 //! where no integrator keeps one, it says so.
 
-use crate::risks::{fastest_speed, tunnelling, volumetric_bodies};
+use crate::risks::{layer_limit, tunnelling, volumetric_bodies};
 use hooke_core::{Integrator, Num, StabilityEstimate};
 use hooke_scene::{Scene, Topology};
 
@@ -52,9 +52,7 @@ pub(crate) fn recommend(scene: &Scene, estimate: &StabilityEstimate, dt: f64) ->
                 "dt = {} s is {limit}; {} a volumetric or stiff body, which Newton's global solve \
                  converges on in a few iterations where block descent's sweeps crawl",
                 Num(dt),
-                names(scene, |b| stiff
-                    .iter()
-                    .any(|m| m.contains(&format!("'{}'", b.name))))
+                subject(&stiff.into_iter().map(|(name, _)| name).collect::<Vec<_>>())
             ),
         };
     }
@@ -73,30 +71,12 @@ pub(crate) fn recommend(scene: &Scene, estimate: &StabilityEstimate, dt: f64) ->
     }
 }
 
-/// The step that keeps two layers of a surface, closing at the fastest speed, from covering
-/// its thickness: the explicit contact phase's condition (none without a surface).
-fn layer_limit(scene: &Scene) -> Option<f64> {
-    let speed = fastest_speed(scene);
-    scene
-        .bodies
-        .iter()
-        .filter(|b| b.thickness > 0.0 && speed > 0.0)
-        .map(|b| b.thickness / (2.0 * speed))
-        .reduce(f64::min)
-}
-
-/// The bodies `keep` selects, named: `body 'a', body 'b'`, or `the bodies` when it is all.
-fn names(scene: &Scene, keep: impl Fn(&hooke_scene::Body) -> bool) -> String {
-    let named: Vec<String> = scene
-        .bodies
-        .iter()
-        .filter(|b| keep(b))
-        .map(|b| format!("'{}'", b.name))
-        .collect();
-    match named.len() {
-        0 => "no body is".into(),
-        1 => format!("body {} is", named[0]),
-        _ => format!("bodies {} are", named.join(", ")),
+/// The bodies `named`, as a sentence's subject: `body 'a' is`, `bodies 'a', 'b' are`.
+fn subject(named: &[String]) -> String {
+    let quoted: Vec<String> = named.iter().map(|n| format!("'{n}'")).collect();
+    match quoted.len() {
+        1 => format!("body {} is", quoted[0]),
+        _ => format!("bodies {} are", quoted.join(", ")),
     }
 }
 
@@ -228,7 +208,7 @@ pub(crate) fn warn_if_other_large_step(scene: &Scene, estimate: &StabilityEstima
     }
     let advice = recommend(scene, estimate, sim.dt());
     if advice.integrator == Integrator::Newton {
-        for message in volumetric_bodies(scene) {
+        for (_, message) in volumetric_bodies(scene) {
             eprintln!("warning: {message}; `hooke check` recommends newton here");
         }
     }

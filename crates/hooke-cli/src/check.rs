@@ -72,7 +72,7 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
     }
     for integrator in promised.into_iter().filter(|i| i.solves_contacts()) {
         if integrator == Integrator::Vbd {
-            for message in crate::risks::volumetric_bodies(&scene) {
+            for (_, message) in crate::risks::volumetric_bodies(&scene) {
                 println!("warning: {message}");
             }
         }

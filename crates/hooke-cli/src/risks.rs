@@ -123,9 +123,17 @@ fn collider_speed(scene: &Scene, k: usize) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// The fastest a particle can move, m/s (see [`fastest`]).
-pub(crate) fn fastest_speed(scene: &Scene) -> f64 {
-    fastest(scene).0
+/// The step that keeps two layers of a surface, closing at the fastest speed a particle can
+/// move, from covering its thickness: the explicit contact phase's condition (none without
+/// a surface, or without motion).
+pub(crate) fn layer_limit(scene: &Scene) -> Option<f64> {
+    let (speed, _) = fastest(scene);
+    scene
+        .bodies
+        .iter()
+        .filter(|b| b.thickness > 0.0 && speed > 0.0)
+        .map(|b| b.thickness / (2.0 * speed))
+        .reduce(f64::min)
 }
 
 /// The fastest a particle can move, m/s: the larger of the fastest now and a free fall from
@@ -163,13 +171,7 @@ pub(crate) fn large_step_advice(scene: &Scene, estimate: &StabilityEstimate) -> 
     }
     // The stable explicit step, and the step that keeps two layers closing at the fastest
     // speed from covering a thickness (the explicit contact phase's condition).
-    let (speed, _) = fastest(scene);
-    let layers = scene
-        .bodies
-        .iter()
-        .filter(|b| b.thickness > 0.0 && speed > 0.0)
-        .map(|b| b.thickness / (2.0 * speed))
-        .fold(f64::INFINITY, f64::min);
+    let layers = layer_limit(scene).unwrap_or(f64::INFINITY);
     let limit = estimate.max_dt(Integrator::Symplectic).min(layers);
     if limit >= TINY_STEP {
         return None;
@@ -235,8 +237,9 @@ pub(crate) fn warn_if_tunnelling(scene: &Scene) {
 /// For block descent: the volumetric bodies (lattices), and the bodies whose springs are
 /// stiff against their inertia at this step (`ks dt² / m` above [`STIFF`]), which it
 /// converges on slowly (a disturbance crosses about one colour of particles per
-/// iteration); the integrator that solves the step globally instead.
-pub(crate) fn volumetric_bodies(scene: &Scene) -> Vec<String> {
+/// iteration); each as its name and a message naming the integrator that solves the step
+/// globally instead.
+pub(crate) fn volumetric_bodies(scene: &Scene) -> Vec<(String, String)> {
     let sim = &scene.simulation;
     let dt = sim.dt();
     let model = sim.model();
@@ -259,12 +262,15 @@ pub(crate) fn volumetric_bodies(scene: &Scene) -> Vec<String> {
             } else {
                 return None;
             };
-            Some(format!(
-                "body '{}' {why}, which block descent converges on slowly (a disturbance \
+            Some((
+                b.name.clone(),
+                format!(
+                    "body '{}' {why}, which block descent converges on slowly (a disturbance \
                  crosses about one colour of particles per iteration; its steps end at their \
                  budget); `--integrator newton` solves each step globally (docs/physics.md \
                  §4.2)",
-                b.name
+                    b.name
+                ),
             ))
         })
         .collect()

@@ -309,50 +309,56 @@ fn pin_power(model: &Model, p: &Particles) -> f64 {
     if model.pin_motions.is_empty() {
         return 0.0;
     }
-    let mut held = vec![Vec3::zeros(); p.len()];
     let mut moving = vec![false; p.len()];
     for m in &model.pin_motions {
         for &i in &m.particles {
             moving[i as usize] = true;
         }
     }
+    let held = holding(model, p, &moving);
+    (0..p.len())
+        .filter(|&i| moving[i])
+        .map(|i| held[i].dot(&p.v[i]).max(0.0))
+        .sum()
+}
+
+/// Per particle flagged in `wanted`, the force that holds it where it is against its
+/// springs and its weight: minus their sum (zero for the others).
+fn holding(model: &Model, p: &Particles, wanted: &[bool]) -> Vec<Vec3> {
+    let mut held = vec![Vec3::zeros(); p.len()];
     for s in &model.springs {
         let (i, j) = (s.i as usize, s.j as usize);
-        if !(moving[i] || moving[j]) {
+        if !(wanted[i] || wanted[j]) {
             continue;
         }
         let f = s.force(&p.x[i], &p.x[j], &p.v[i], &p.v[j]);
         held[i] -= f;
         held[j] += f;
     }
-    (0..p.len())
-        .filter(|&i| moving[i])
-        .map(|i| (held[i] - model.gravity * p.mass[i]).dot(&p.v[i]).max(0.0))
-        .sum()
+    for (i, h) in held.iter_mut().enumerate().filter(|(i, _)| wanted[*i]) {
+        *h -= model.gravity * p.mass[i];
+    }
+    held
 }
 
 /// The power each moving collider puts in now: a particle touching it (inside it, or
 /// within its contact thickness or a point's) is held against its springs and its weight,
 /// as a keyed pin is, so the collider's force on it is minus their sum, counted where the
-/// collider's surface there moves along it. Still colliders do no work (zero).
+/// collider's surface there moves along it. Still colliders do no work (none is listed
+/// when no collider moves, so a check allocates nothing then).
 fn collider_power(model: &Model, p: &Particles) -> Vec<f64> {
-    let mut power = vec![0.0; model.colliders.len()];
     if !model.colliders.iter().any(|c| c.shape.is_moving()) {
-        return power;
+        return Vec::new();
     }
-    let mut held = vec![Vec3::zeros(); p.len()];
-    for s in &model.springs {
-        let (i, j) = (s.i as usize, s.j as usize);
-        let f = s.force(&p.x[i], &p.x[j], &p.v[i], &p.v[j]);
-        held[i] -= f;
-        held[j] += f;
-    }
+    let mut power = vec![0.0; model.colliders.len()];
+    let free: Vec<bool> = p.inv_mass.iter().map(|&inv| inv != 0.0).collect();
+    let held = holding(model, p, &free);
     let point = model.point_thickness();
     for (k, slot) in model.colliders.iter().enumerate() {
         if !slot.shape.is_moving() {
             continue;
         }
-        for i in (0..p.len()).filter(|&i| p.inv_mass[i] != 0.0) {
+        for i in (0..p.len()).filter(|&i| free[i]) {
             let margin = model.margin(i).max(point);
             let mut normal = None;
             slot.shape
@@ -361,9 +367,7 @@ fn collider_power(model: &Model, p: &Particles) -> Vec<f64> {
                 continue;
             };
             // The collider pushes along its normal only: what holds the particle there.
-            let push = (held[i] - model.gravity * p.mass[i])
-                .dot(&c.normal)
-                .max(0.0);
+            let push = held[i].dot(&c.normal).max(0.0);
             let along = slot.shape.velocity(&c.point).dot(&c.normal);
             power[k] += (push * along).max(0.0);
         }
