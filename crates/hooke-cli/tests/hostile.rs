@@ -430,9 +430,10 @@ fn an_interrupt_stops_a_newton_step_under_way() {
     let out = child.wait_with_output().unwrap();
     let waited = asked.elapsed();
     assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
-    // A bound no machine's load explains: the step itself would take hours.
+    // The project's bound for a hung process, not a slow machine (as `wait_for`'s): the
+    // step itself would take hours; the interrupt is seen within a few products.
     assert!(
-        waited.as_secs() < 60,
+        waited.as_secs() < 300,
         "stopped {waited:?} after the interrupt"
     );
     let csv = std::fs::read_to_string(dir.join("t.csv")).unwrap();
