@@ -125,8 +125,8 @@ fn hanging_in_wind(wind_z: f64) -> hooke_scene::Scene {
     let body = &mut spec.bodies[0];
     // The pinned edge runs along z at the lowest x; each particle hangs as far below it as
     // it lay beyond it, and the edge becomes the x axis.
-    let edge = x[body.pins[0]].x;
-    assert!(body.pins.iter().all(|&p| x[p].x == edge));
+    let edge = x[body.pins.indices()[0]].x;
+    assert!(body.pins.indices().iter().all(|&p| x[p].x == edge));
     assert!(x.iter().all(|p| p.x >= edge));
     let hung = x
         .iter()

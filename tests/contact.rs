@@ -21,7 +21,7 @@ pub(crate) struct Frame {
 
 fn read_frame(path: &Path) -> Frame {
     let options = tobj::LoadOptions {
-        single_index: true,
+        single_index: false,
         triangulate: true,
         ..tobj::LoadOptions::default()
     };
@@ -267,7 +267,7 @@ fn skipping_what_cannot_touch_changes_no_bit() {
             *spacing = hooke_scene::spec::Positive::of(1.6 / 47.0);
         }
         body.mass = Some(hooke_scene::spec::Positive::of(0.4 / (48.0 * 48.0)));
-        body.pins.clear();
+        body.pins = Default::default();
     };
     let cases: [(&str, Option<&str>, bool, u64); 5] = [
         ("cloth-table", None, false, 6000),

@@ -15,6 +15,7 @@ mod images;
 mod large_steps;
 mod layout;
 mod material;
+mod meshes;
 mod motion;
 mod newton;
 mod oscillator;

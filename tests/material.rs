@@ -12,7 +12,7 @@ const G: f64 = 9.81;
 /// horizontal `φ(s)` solves `B φ'' = -q (L - s) cos φ` with `φ(0) = 0` and `φ'(L) = 0`
 /// (the moment vanishes at the tip). Shooting on `φ'(0)` by bisection, RK4 in `s`. Returns
 /// the chord's angle below the horizontal from the clamp to the tip, in degrees.
-fn elastica_chord(b: f64, q: f64, l: f64) -> f64 {
+pub(crate) fn elastica_chord(b: f64, q: f64, l: f64) -> f64 {
     let steps = 4000;
     let ds = l / steps as f64;
     // (φ, φ', x, y) along s.

@@ -83,7 +83,7 @@ fn keyframed_pins_sit_at_their_keys_at_every_step_and_carry_the_cloth() {
             centroid(&scene)
         };
         let mut scene = carried(integrator, dt);
-        let pins: Vec<usize> = scene.spec.bodies[0].pins.clone();
+        let pins: Vec<usize> = scene.spec.bodies[0].pins.indices().to_vec();
         let start: Vec<Vec3> = pins
             .iter()
             .map(|&i| scene.simulation.particles().x[i])
@@ -156,7 +156,7 @@ fn centroid(scene: &Scene) -> Vec3 {
 fn pin_motions_without_pins_or_in_the_wrong_order_are_refused() {
     let mut spec = hooke_scene::builtin::builtin("hanging-cloth").unwrap();
     spec.bodies[0].pin_motion = Some(MotionSpec { keys: keys() });
-    spec.bodies[0].pins.clear();
+    spec.bodies[0].pins = Default::default();
     let e = spec
         .build(&root().join("assets/scenes"))
         .unwrap_err()

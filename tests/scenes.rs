@@ -54,6 +54,11 @@ pub fn tracked(scene: &Scene) -> Vec<usize> {
                 v
             }
             Topology::Points => (0..body.range.len()).collect(),
+            // The first, middle and last particle of a body made from a mesh.
+            Topology::Mesh | Topology::Solid => {
+                let n = body.range.len();
+                vec![0, n / 2, n - 1]
+            }
         };
         out.extend(local.into_iter().map(|i| s + i));
     }

@@ -51,6 +51,13 @@ class Simulation:
     def springs(self) -> npt.NDArray[np.int64]:
         """(M, 2) end particles of every spring."""
     @property
+    def faces(self) -> npt.NDArray[np.int64]:
+        """(F, 3) particle indices of every body's surface triangles."""
+    def mesh(
+        self, name: str
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+        """Body name as shown: (V, 3) vertices now (a mesh body's in its file's order), (T, 3) triangles."""
+    @property
     def bodies(self) -> list[tuple[str, int, int]]:
         """(name, first particle, particle count) of every body."""
     def collider_pose(

@@ -331,6 +331,51 @@ impl Simulation {
         Ok(array)
     }
 
+    /// The bodies' surface triangles, an `(F, 3)` int64 array of particle indices (rows of
+    /// `positions`), read-only: every body's, in the scene's order; a body made from a mesh
+    /// has its faces cut into triangles (quads along their shorter diagonal).
+    #[getter]
+    fn faces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let inner = self.lock()?;
+        let triangles: Vec<[u32; 3]> = inner
+            .scene
+            .bodies
+            .iter()
+            .flat_map(|b| b.triangles.iter().copied())
+            .collect();
+        let flat: Vec<i64> = triangles.iter().flatten().map(|&i| i64::from(i)).collect();
+        let array = PyArray1::from_vec(py, flat).reshape([triangles.len(), 3])?;
+        read_only(array.as_any())?;
+        Ok(array)
+    }
+
+    /// Body `name` as it is shown and exported: `(vertices, triangles)`, a `(V, 3)` float64
+    /// array of its vertices now and a `(T, 3)` int64 array of rows of it. A body made from a
+    /// mesh has its file's vertices in their count and order (its faces as fans of
+    /// triangles); any other, its particles and surface triangles.
+    fn mesh<'py>(
+        &self,
+        py: Python<'py>,
+        name: &str,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>)> {
+        let inner = self.lock()?;
+        let scene = &inner.scene;
+        let Some(body) = scene.bodies.iter().find(|b| b.name == name) else {
+            let names: Vec<&str> = scene.bodies.iter().map(|b| b.name.as_str()).collect();
+            return Err(HookeError::new_err(format!(
+                "the scene has no body '{name}'; its bodies: {}",
+                names.join(", ")
+            )));
+        };
+        let mut x = Vec::new();
+        body.vertices(&scene.simulation.particles().x, &mut x);
+        let triangles = body.face_triangles();
+        let flat: Vec<i64> = triangles.iter().flatten().map(|&i| i64::from(i)).collect();
+        let faces = PyArray1::from_vec(py, flat).reshape([triangles.len(), 3])?;
+        read_only(faces.as_any())?;
+        Ok((matrix(py, &x)?, faces))
+    }
+
     /// The bodies: a list of `(name, first particle, particle count)`.
     #[getter]
     fn bodies(&self) -> PyResult<Vec<(String, usize, usize)>> {

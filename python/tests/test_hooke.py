@@ -349,3 +349,17 @@ def test_report_writes_the_page_and_its_numbers(tmp_path):
     assert set(orders) == {"euler", "symplectic", "midpoint", "rk4", "implicit", "vbd", "newton"}
     for name, (slope, expected) in orders.items():
         assert abs(slope - expected) <= 0.1, (name, slope, expected)
+
+
+def test_a_mesh_body_loads_with_its_faces_and_its_files_vertices():
+    examples = ROOT / "assets" / "examples"
+    sim = hooke.load(str(examples / "flag-hole.toml"), steps=10)
+    faces = sim.faces
+    assert faces.shape[1] == 3 and faces.dtype == np.int64
+    assert faces.min() >= 0 and faces.max() < len(sim.positions)
+    vertices, triangles = sim.mesh("flag")
+    # The OBJ's 651 vertices, in its order, though 30 of them are in no face.
+    assert vertices.shape == (651, 3) and len(sim.positions) == 621
+    assert triangles.max() < 651
+    with pytest.raises(hooke.HookeError, match="no body 'cloth'"):
+        sim.mesh("cloth")

@@ -93,6 +93,8 @@ fn kept(scene: &Scene) -> String {
                 Topology::Grid(_) => "a grid",
                 Topology::Lattice(_) => "a lattice",
                 Topology::Points => "points",
+                Topology::Mesh => "a cloth mesh",
+                Topology::Solid => "a filled mesh",
             };
             if b.thickness > 0.0 {
                 format!(

@@ -255,7 +255,10 @@ pub(crate) fn volumetric_bodies(scene: &Scene) -> Vec<(String, String)> {
                 .map(|s| s.ks * dt * dt / masses[s.i as usize].min(masses[s.j as usize]))
                 .filter(|r| r.is_finite())
                 .fold(0.0, f64::max);
-            let why = if matches!(b.topology, hooke_scene::Topology::Lattice(_)) {
+            let why = if matches!(
+                b.topology,
+                hooke_scene::Topology::Lattice(_) | hooke_scene::Topology::Solid
+            ) {
                 "is a volumetric lattice".to_string()
             } else if stiffness > STIFF {
                 format!("has springs with ks dt²/m up to {stiffness:.1e}")

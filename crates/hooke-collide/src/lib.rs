@@ -32,6 +32,7 @@ mod box_interior;
 mod cylinder;
 mod obj;
 mod plane;
+mod polygons;
 mod sphere;
 pub mod table;
 mod trimesh;
@@ -40,6 +41,7 @@ pub use box_interior::{BOX_FACES, BoxInterior};
 pub use cylinder::Cylinder;
 pub use obj::{MeshError, MeshPart, Placement, load_obj, parse_obj};
 pub use plane::Plane;
+pub use polygons::{Polygon, PolygonMesh};
 pub use sphere::Sphere;
 pub use trimesh::{TriMeshCollider, closedness_defect, signed_volume};
 

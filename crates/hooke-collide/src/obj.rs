@@ -267,6 +267,6 @@ pub fn parse_obj(
 const EXCERPT_CHARS: usize = 80;
 
 /// At most [`EXCERPT_CHARS`] characters of `text`, with `…` where it was cut.
-fn excerpt(text: &str) -> String {
+pub(crate) fn excerpt(text: &str) -> String {
     hooke_core::excerpt(text, EXCERPT_CHARS)
 }

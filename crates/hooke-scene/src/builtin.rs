@@ -49,7 +49,7 @@ fn body(
         origin: f3(origin),
         rotate: f3([0.0; 3]),
         velocity: f3([0.0; 3]),
-        pins: Vec::new(),
+        pins: Default::default(),
         positions: None,
         velocities: None,
         shape,
@@ -108,7 +108,7 @@ pub fn single_spring() -> SceneSpec {
         },
         SpringsSpec::default(),
     );
-    b.pins = vec![0];
+    b.pins = vec![0].into();
     b.springs.pairs = vec![PairSpec {
         i: 0,
         j: 1,
@@ -149,7 +149,7 @@ pub fn chain() -> SceneSpec {
             ..SpringsSpec::default()
         },
     );
-    b.pins = vec![0];
+    b.pins = vec![0].into();
     SceneSpec {
         name: "chain".into(),
         description:
@@ -212,7 +212,7 @@ pub fn hanging_cloth() -> SceneSpec {
             pairs: Vec::new(),
         },
     );
-    b.pins = vec![0, n - 1];
+    b.pins = vec![0, n - 1].into();
     SceneSpec {
         name: "hanging-cloth".into(),
         description:
@@ -318,7 +318,7 @@ pub fn flag() -> SceneSpec {
     );
     // Rotated about x, the grid's local z runs up: particles 0..hoist are the hoist.
     b.rotate = f3([-90.0, 0.0, 0.0]);
-    b.pins = (0..hoist).collect();
+    b.pins = (0..hoist).collect::<Vec<_>>().into();
     b.aero = Some(AeroSpec {
         drag: NonNegative::of(1.0),
         lift: Finite::of(0.3),

@@ -29,6 +29,16 @@ pub(crate) fn body_surface(
     // its default thickness is none, and contact keys written for it are refused by name.
     let default = if triangles.is_empty() {
         0.0
+    } else if let ShapeSpec::Mesh { .. } = body.shape {
+        // As a grid's: at most a quarter of the shortest edge, so that no two neighbours
+        // start within each other's thickness, however irregular the mesh.
+        let rest = |i: u32| local[i as usize - particles.start];
+        let shortest = triangles
+            .iter()
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+            .map(|(a, b)| (rest(a) - rest(b)).norm())
+            .fold(f64::INFINITY, f64::min);
+        DEFAULT_CLOTH_THICKNESS.min(0.25 * shortest)
     } else {
         default_thickness(&body.shape)
     };

@@ -106,6 +106,21 @@ impl SceneSpec {
         let mut f = Footprint::default();
         for (b, body) in self.bodies.iter().enumerate() {
             let key = format!("body[{b}] '{}'", body.name);
+            if let Some(path) = body.shape.mesh_path() {
+                let (particles, springs) = mesh_estimate(&body.shape, path, base);
+                f.particles = f.particles.saturating_add(particles);
+                f.springs = f.springs.saturating_add(springs);
+                f.surface_particles = f.surface_particles.saturating_add(particles);
+                let bytes = Footprint {
+                    particles,
+                    springs,
+                    surface_particles: particles,
+                    ..Footprint::default()
+                }
+                .bytes();
+                f.note(format!("{key}.shape.path"), bytes);
+                continue;
+            }
             let (lattice, size_key) = match &body.shape {
                 ShapeSpec::Chain { count, .. } => (
                     Lattice {
@@ -126,6 +141,7 @@ impl SceneSpec {
                     },
                     "positions",
                 ),
+                ShapeSpec::Mesh { .. } | ShapeSpec::Solid { .. } => continue,
             };
             let particles = lattice
                 .size
@@ -191,6 +207,50 @@ impl SceneSpec {
             }
         }
         f
+    }
+}
+
+/// Particles and springs a body made from the mesh at `path` will have, estimated from the
+/// file without building it: a vertex per `v` line and about nine springs each for a cloth
+/// (edges and bending pairs); the lattice over the vertices' bounding box and thirteen
+/// springs a particle for a solid. A file that cannot be read counts as empty.
+fn mesh_estimate(shape: &ShapeSpec, path: &str, base: &Path) -> (u64, u64) {
+    let Ok((text, _)) = crate::colliders::mesh_text(path, base) else {
+        return (0, 0);
+    };
+    let vertices = text.lines().filter(|l| l.starts_with("v ")).map(|l| {
+        let p: Vec<f64> = l
+            .split_whitespace()
+            .skip(1)
+            .filter_map(|w| w.parse().ok())
+            .collect();
+        [0, 1, 2].map(|d| p.get(d).copied().unwrap_or(0.0))
+    });
+    match shape {
+        ShapeSpec::Solid { scale, spacing, .. } => {
+            let (lo, hi) = vertices.fold(
+                ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+                |(lo, hi), p| {
+                    (
+                        [0, 1, 2].map(|d| lo[d].min(p[d])),
+                        [0, 1, 2].map(|d| hi[d].max(p[d])),
+                    )
+                },
+            );
+            let cells = (0..3)
+                .map(|d| ((hi[d] - lo[d]).max(0.0) * scale[d].get() / spacing.get()).ceil() + 1.0)
+                .product::<f64>();
+            let n = if cells.is_finite() {
+                cells.min(u64::MAX as f64) as u64
+            } else {
+                0
+            };
+            (n, n.saturating_mul(13))
+        }
+        _ => {
+            let n = vertices.count() as u64;
+            (n, n.saturating_mul(9))
+        }
     }
 }
 

@@ -19,6 +19,8 @@ pub(crate) fn particle_count(shape: &ShapeSpec) -> Option<usize> {
         ShapeSpec::Grid { size, .. } => size[0].checked_mul(size[1]),
         ShapeSpec::Lattice { size, .. } => size[0].checked_mul(size[1])?.checked_mul(size[2]),
         ShapeSpec::Points { positions } => Some(positions.len()),
+        // Counted as the file is read.
+        ShapeSpec::Mesh { .. } | ShapeSpec::Solid { .. } => Some(0),
     }
 }
 

@@ -329,6 +329,14 @@ pub(crate) fn check_ranges(spec: &SceneSpec) -> Result<(), BuildError> {
                     each(&key(&format!("shape.positions[{i}]")), p, LENGTH)?;
                 }
             }
+            ShapeSpec::Mesh { weld, .. } => {
+                if let Some(w) = weld {
+                    check(&key("shape.weld"), w.get(), SIZE)?;
+                }
+            }
+            ShapeSpec::Solid { spacing, .. } => {
+                check(&key("shape.spacing"), spacing.get(), SIZE)?;
+            }
         }
         for (name, params) in [
             ("structural", body.springs.structural),

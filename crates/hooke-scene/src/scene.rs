@@ -1,10 +1,12 @@
 //! What building a description gives: the scene ready to step, its bodies and the
 //! geometry of its colliders for drawing.
 
+use crate::skin::Skin;
 use crate::spec::SceneSpec;
 use hooke_collide::{BoxInterior, Cylinder, Sphere};
 use hooke_core::{Simulation, Vec3};
 use std::ops::Range;
+use std::sync::Arc;
 
 /// How a body's particles are arranged, for drawing surfaces and picking subsets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -17,6 +19,10 @@ pub enum Topology {
     Lattice([usize; 3]),
     /// Unstructured points.
     Points,
+    /// A cloth made from a surface mesh (its faces are in the body's [`Skin`]).
+    Mesh,
+    /// A lattice filling a closed mesh, which it carries as its [`Skin`].
+    Solid,
 }
 
 /// A body of a built scene: its name, where its particles are, how they are arranged.
@@ -32,6 +38,71 @@ pub struct Body {
     pub triangles: Vec<[u32; 3]>,
     /// Contact thickness of the surface, metres (zero: bare per-particle contacts, docs/physics.md §3.3).
     pub thickness: f64,
+    /// For a body made from a mesh, the user's vertices and faces, which drawing and every
+    /// export show in place of the particles.
+    pub skin: Option<Arc<Skin>>,
+}
+
+impl Body {
+    /// How many vertices the body shows: its mesh's, or its particles.
+    pub fn vertex_count(&self) -> usize {
+        self.skin
+            .as_ref()
+            .map_or(self.range.len(), |s| s.vertices.len())
+    }
+
+    /// The positions of the vertices the body shows, given every particle's `x`, into `out`:
+    /// its mesh's vertices in the file's order, or its particles.
+    pub fn vertices(&self, x: &[Vec3], out: &mut Vec<Vec3>) {
+        match &self.skin {
+            Some(skin) => skin.positions(x, out),
+            None => {
+                out.clear();
+                out.extend_from_slice(&x[self.range.clone()]);
+            }
+        }
+    }
+
+    /// The velocities of the vertices the body shows, given every particle's `v`.
+    pub fn vertex_velocities(&self, v: &[Vec3], out: &mut Vec<Vec3>) {
+        match &self.skin {
+            Some(skin) => {
+                out.clear();
+                out.extend(skin.vertices.iter().map(|s| s.velocity(v)));
+            }
+            None => {
+                out.clear();
+                out.extend_from_slice(&v[self.range.clone()]);
+            }
+        }
+    }
+
+    /// The faces the body shows, as polygons of indices into [`Body::vertices`]: its
+    /// mesh's faces as written (quads stay quads), or its surface triangles.
+    pub fn faces(&self) -> Vec<Vec<u32>> {
+        match &self.skin {
+            Some(skin) => skin.faces.iter().map(|f| f.corners.clone()).collect(),
+            None => {
+                let s = self.range.start as u32;
+                self.triangles
+                    .iter()
+                    .map(|t| t.iter().map(|&i| i - s).collect())
+                    .collect()
+            }
+        }
+    }
+
+    /// [`Body::faces`] as triangles (polygons as fans): what is drawn and what formats of
+    /// triangles only take.
+    pub fn face_triangles(&self) -> Vec<[u32; 3]> {
+        match &self.skin {
+            Some(skin) => skin.triangles(),
+            None => {
+                let s = self.range.start as u32;
+                self.triangles.iter().map(|t| t.map(|i| i - s)).collect()
+            }
+        }
+    }
 }
 
 /// The geometry of a collider, for drawing.
@@ -69,6 +140,9 @@ pub struct Scene {
     /// The particles moved out of velocity-level colliders before the first step, per
     /// collider (see [`hooke_core::Simulation::push_out_start`]); said as warnings.
     pub pushed_out: Vec<hooke_core::PushedOut>,
+    /// What building did to the bodies that the user should hear of (a mesh's dropped
+    /// faces or vertices), one line each; said with [`Scene::warnings`].
+    pub build_warnings: Vec<String>,
 }
 
 /// Where a moving collider is at some time: `x ↦ pivot + translate + R (x − pivot)`, with

@@ -270,9 +270,10 @@ pub struct BodySpec {
     /// Initial velocity of every particle, m/s.
     #[serde(default = "origin")]
     pub velocity: [Finite; 3],
-    /// Pinned particles, as indices within the body.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub pins: Vec<usize>,
+    /// Pinned particles: indices within the body (for a mesh, the file's vertex indices
+    /// from 0), or a region or group (see [`Pins`]).
+    #[serde(default, skip_serializing_if = "Pins::is_empty")]
+    pub pins: Pins,
     /// Explicit initial positions overriding the generated ones (world coordinates); rest
     /// lengths still come from the generated, undeformed shape.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -310,6 +311,74 @@ pub struct BodySpec {
     /// only bodies with a surface feel air).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub aero: Option<AeroSpec>,
+}
+
+/// `pins`: which particles are held.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(
+    untagged,
+    expecting = "a list of indices, or one of { box = [[x0, y0, z0], [x1, y1, z1]] }, \
+                 { sphere = { center = [x, y, z], radius = r } }, { group = \"NAME\" }"
+)]
+pub enum Pins {
+    /// Particle indices within the body; for a mesh, vertex indices in the file's order
+    /// from 0.
+    Indices(Vec<usize>),
+    /// Every particle in a region (in the body's own coordinates; a mesh's are the file's,
+    /// before `scale`), or every vertex of an OBJ group's faces.
+    Region(PinRegion),
+}
+
+impl Default for Pins {
+    fn default() -> Self {
+        Self::Indices(Vec::new())
+    }
+}
+
+impl From<Vec<usize>> for Pins {
+    fn from(v: Vec<usize>) -> Self {
+        Self::Indices(v)
+    }
+}
+
+impl Pins {
+    /// Whether no pin is asked for.
+    pub fn is_empty(&self) -> bool {
+        matches!(self, Self::Indices(v) if v.is_empty())
+    }
+
+    /// The indices, when pins are given as indices.
+    pub fn indices(&self) -> &[usize] {
+        match self {
+            Self::Indices(v) => v,
+            Self::Region(_) => &[],
+        }
+    }
+}
+
+/// `pins = { box = … }`, `{ sphere = … }` or `{ group = … }`: exactly one of them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PinRegion {
+    /// Opposite corners of a box.
+    #[serde(rename = "box", default, skip_serializing_if = "Option::is_none")]
+    pub aabb: Option<[[Finite; 3]; 2]>,
+    /// A ball.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sphere: Option<PinSphere>,
+    /// The name of an OBJ group (`g`) or object (`o`) of a mesh body.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub group: Option<String>,
+}
+
+/// A ball of pins.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PinSphere {
+    /// Its centre.
+    pub center: [Finite; 3],
+    /// Its radius.
+    pub radius: Positive,
 }
 
 fn origin() -> [Finite; 3] {
@@ -352,6 +421,38 @@ pub enum ShapeSpec {
         /// Positions, metres.
         positions: Vec<[Finite; 3]>,
     },
+    /// A cloth from a surface mesh (docs/physics.md §1.1): one particle per vertex the faces
+    /// use, springs on its edges and quads' diagonals, bending across its interior edges.
+    Mesh {
+        /// The OBJ file, relative to the scene file, or `builtin:NAME`.
+        path: String,
+        /// Per-axis scale of the file's coordinates.
+        scale: [Positive; 3],
+        /// Merges vertices closer than this, metres in the file's coordinates (a triangle
+        /// soup); none by default: vertices are the file's.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        weld: Option<Positive>,
+    },
+    /// A jelly filling a closed mesh with a lattice of `spacing`; the mesh's surface is
+    /// carried by the lattice, each vertex trilinearly in its cell.
+    Solid {
+        /// The OBJ file, relative to the scene file, or `builtin:NAME`.
+        path: String,
+        /// Per-axis scale of the file's coordinates.
+        scale: [Positive; 3],
+        /// The lattice's spacing, metres.
+        spacing: Positive,
+    },
+}
+
+impl ShapeSpec {
+    /// The mesh file a `mesh` or `solid` body reads.
+    pub fn mesh_path(&self) -> Option<&str> {
+        match self {
+            Self::Mesh { path, .. } | Self::Solid { path, .. } => Some(path),
+            _ => None,
+        }
+    }
 }
 
 /// Stiffness and damping of a family of springs.

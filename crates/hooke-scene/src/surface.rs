@@ -45,6 +45,7 @@ pub fn triangles(topology: Topology, start: usize) -> Vec<[u32; 3]> {
             out.extend(flip(sheet(b, c, |j, k| idx(a - 1, j, k))));
             out
         }
-        Topology::Chain | Topology::Points => Vec::new(),
+        // Their triangles are the mesh's, not the topology's.
+        Topology::Chain | Topology::Points | Topology::Mesh | Topology::Solid => Vec::new(),
     }
 }

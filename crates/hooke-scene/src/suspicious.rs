@@ -31,7 +31,7 @@ impl Scene {
     /// Warnings about the scene as built (see the module's documentation), one line each;
     /// none for the built-in scenes.
     pub fn warnings(&self) -> Vec<String> {
-        let mut said = Vec::new();
+        let mut said = self.build_warnings.clone();
         let x = &self.simulation.particles().x;
         let slots = &self.simulation.model().colliders;
         for (k, geometry) in self.colliders.iter().enumerate() {

@@ -37,6 +37,9 @@ pub(crate) struct ShapeTable {
     size: Option<Vec<usize>>,
     spacing: Option<Positive>,
     positions: Option<Vec<[Finite; 3]>>,
+    path: Option<String>,
+    scale: Option<[Positive; 3]>,
+    weld: Option<Positive>,
 }
 
 #[derive(Deserialize)]
@@ -46,6 +49,8 @@ enum ShapeKind {
     Grid,
     Lattice,
     Points,
+    Mesh,
+    Solid,
 }
 
 impl TryFrom<ShapeTable> for ShapeSpec {
@@ -57,6 +62,9 @@ impl TryFrom<ShapeTable> for ShapeSpec {
             ("size", t.size.is_some()),
             ("spacing", t.spacing.is_some()),
             ("positions", t.positions.is_some()),
+            ("path", t.path.is_some()),
+            ("scale", t.scale.is_some()),
+            ("weld", t.weld.is_some()),
         ];
         let size = |kind: &str, n: usize, axes: &str| -> Result<Vec<usize>, String> {
             let size = need(kind, "size", t.size.clone())?;
@@ -97,6 +105,22 @@ impl TryFrom<ShapeTable> for ShapeSpec {
                 only("points", &["positions"], &present)?;
                 ShapeSpec::Points {
                     positions: need("points", "positions", t.positions)?,
+                }
+            }
+            ShapeKind::Mesh => {
+                only("mesh", &["path", "scale", "weld"], &present)?;
+                ShapeSpec::Mesh {
+                    path: need("mesh", "path", t.path)?,
+                    scale: t.scale.unwrap_or([Positive::of(1.0); 3]),
+                    weld: t.weld,
+                }
+            }
+            ShapeKind::Solid => {
+                only("solid", &["path", "scale", "spacing"], &present)?;
+                ShapeSpec::Solid {
+                    path: need("solid", "path", t.path)?,
+                    scale: t.scale.unwrap_or([Positive::of(1.0); 3]),
+                    spacing: need("solid", "spacing", t.spacing)?,
                 }
             }
         })

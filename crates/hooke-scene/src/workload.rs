@@ -47,7 +47,7 @@ pub fn cloth(n: usize) -> SceneSpec {
             origin: [Finite::of(0.0), Finite::of(1.0), Finite::of(0.0)],
             rotate: zero,
             velocity: zero,
-            pins: vec![0, n - 1],
+            pins: vec![0, n - 1].into(),
             positions: None,
             velocities: None,
             shape: ShapeSpec::Grid {

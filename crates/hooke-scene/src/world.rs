@@ -414,7 +414,7 @@ impl World {
                 origin: [Finite::of(0.0); 3],
                 rotate: [Finite::of(0.0); 3],
                 velocity: [Finite::of(0.0); 3],
-                pins: Vec::new(),
+                pins: Default::default(),
                 positions: Some(finite_list("positions", &self.positions)?),
                 velocities: Some(finite_list("velocities", &self.velocities)?),
                 shape: ShapeSpec::Lattice {

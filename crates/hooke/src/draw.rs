@@ -2,7 +2,7 @@
 
 use hooke_core::{SpringKind, Vec3};
 use hooke_render::{Camera, DrawList, Line, Mesh, Point, Rgb};
-use hooke_scene::{ColliderGeometry, Scene, Topology, collider_mesh};
+use hooke_scene::{Body, ColliderGeometry, Scene, SkinVertex, Topology, collider_mesh};
 
 /// What to draw of the bodies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -89,6 +89,44 @@ fn sheet(
     let colors = tint.map_or_else(Vec::new, |tint| {
         (0..rows * cols)
             .map(|k| tint[index(k / cols, k % cols)])
+            .collect()
+    });
+    list.meshes.push(Mesh {
+        positions,
+        normals,
+        triangles,
+        color,
+        colors,
+    });
+}
+
+/// A body made from a mesh, drawn as the user's faces at its vertices (which follow the
+/// particles), each vertex tinted as the particle it is or rides nearest.
+fn skin(list: &mut DrawList, (x, tint): (&[Vec3], Option<&[Rgb]>), body: &Body, color: Rgb) {
+    let Some(skin) = &body.skin else {
+        return;
+    };
+    let mut positions = Vec::new();
+    body.vertices(x, &mut positions);
+    let triangles = skin.triangles();
+    let mut normals = Vec::new();
+    crate::export::vertex_normals(&positions, &triangles, &mut normals);
+    for n in &mut normals {
+        if *n == Vec3::zeros() {
+            *n = Vec3::y();
+        }
+    }
+    let colors = tint.map_or_else(Vec::new, |tint| {
+        skin.vertices
+            .iter()
+            .map(|v| match v {
+                SkinVertex::Particle(i) => tint[*i as usize],
+                SkinVertex::Embedded { corners, weights } => {
+                    let k = (0..8).fold(0, |k, m| if weights[m] > weights[k] { m } else { k });
+                    tint[corners[k] as usize]
+                }
+                SkinVertex::Fixed(_) => color,
+            })
             .collect()
     });
     list.meshes.push(Mesh {
@@ -239,6 +277,8 @@ pub fn draw_tinted(
                 sheet(&mut list, xs, b, c, |j, k| idx(0, j, k), JELLY);
                 sheet(&mut list, xs, b, c, |j, k| idx(a - 1, j, k), JELLY);
             }
+            Topology::Mesh if surfaces => skin(&mut list, xs, body, CLOTH),
+            Topology::Solid if surfaces => skin(&mut list, xs, body, JELLY),
             Topology::Chain | Topology::Points => {
                 for i in body.range.clone() {
                     let pinned = sim.particles().is_pinned(i);

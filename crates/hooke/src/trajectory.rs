@@ -49,10 +49,50 @@ impl TrajectoryWriter {
     }
 }
 
+impl TrajectoryWriter {
+    /// Appends one frame of the vertices `scene`'s bodies show at `time` seconds, body after
+    /// body: a generated body's particles, a mesh body's file vertices in their count and
+    /// order (docs/physics.md §6). Without mesh bodies these are the particles, in order.
+    pub fn append_scene(
+        &mut self,
+        frame: u64,
+        time: f64,
+        scene: &hooke_scene::Scene,
+    ) -> Result<()> {
+        let p = scene.simulation.particles();
+        if scene.bodies.iter().all(|b| b.skin.is_none()) {
+            return self.append(frame, time, p);
+        }
+        let (mut x, mut v) = (Vec::new(), Vec::new());
+        let mut row = 0usize;
+        let w = self.file.writer();
+        for body in &scene.bodies {
+            body.vertices(&p.x, &mut x);
+            body.vertex_velocities(&p.v, &mut v);
+            for (x, v) in x.iter().zip(&v) {
+                writeln!(
+                    w,
+                    "{frame},{},{row},{},{},{},{},{},{}",
+                    Num(time),
+                    Num(x.x),
+                    Num(x.y),
+                    Num(x.z),
+                    Num(v.x),
+                    Num(v.y),
+                    Num(v.z)
+                )
+                .with_context(|| format!("cannot write {}", self.path.display()))?;
+                row += 1;
+            }
+        }
+        Ok(())
+    }
+}
+
 impl crate::Sink for TrajectoryWriter {
     fn frame(&mut self, frame: u64, scene: &hooke_scene::Scene) -> Result<()> {
         let time = crate::driver::frame_time(scene, frame);
-        self.append(frame, time, scene.simulation.particles())
+        self.append_scene(frame, time, scene)
     }
 
     /// Puts the file in place. Called after the last frame, and after a divergence too: the

@@ -205,10 +205,11 @@ fn frame_folder(dir: &Path, ext: &str) -> Result<crate::output::lock::FolderLock
 }
 
 /// What a body becomes outside Hooke.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Shape<'a> {
-    /// A triangle mesh: its triangles as simulation particle indices.
-    Mesh(&'a [[u32; 3]]),
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// A mesh: its faces as polygons of indices into the vertices the body shows
+    /// ([`Body::vertices`]; a mesh body's quads stay quads).
+    Mesh(Vec<Vec<u32>>),
     /// A polyline through its particles in order (a chain).
     Curve,
     /// Loose points.
@@ -216,9 +217,9 @@ pub enum Shape<'a> {
 }
 
 /// The shape `body` is exported as.
-pub fn shape(body: &Body) -> Shape<'_> {
-    if !body.triangles.is_empty() {
-        Shape::Mesh(&body.triangles)
+pub fn shape(body: &Body) -> Shape {
+    if body.skin.is_some() || !body.triangles.is_empty() {
+        Shape::Mesh(body.faces())
     } else if body.topology == Topology::Chain {
         Shape::Curve
     } else {

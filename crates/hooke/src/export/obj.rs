@@ -1,9 +1,10 @@
 //! `--export DIR/ --format obj`: one Wavefront OBJ per frame, in world coordinates, so that
 //! anyone can check or render the frames with their own tools.
 //!
-//! `DIR/frame-00000.obj` holds frame 0, and so on. Each body with a surface is an object
-//! `body:<name>` of its particles' positions and its surface triangles (the triangles the
-//! contacts act on); a chain or loose points is an object of its positions with its springs
+//! `DIR/frame-00000.obj` holds frame 0, and so on. A body made from a mesh is an object
+//! `body:<name>` of its file's vertices, in their count and order, with its texture
+//! coordinates and faces as written; any other body with a surface is one of its particles'
+//! positions and its surface triangles (the triangles the contacts act on); a chain or loose points is an object of its positions with its springs
 //! as `l` elements. Each collider is an object `collider:<index>-<kind>` of triangles (see
 //! [`super::collider_triangles`]). Numbers are Rust's shortest round-trip numbers
 //! ([`hooke_core::Num`]); every file is written whole or not at all.
@@ -55,33 +56,81 @@ fn vertex(w: &mut impl Write, p: &Vec3) -> std::io::Result<()> {
     writeln!(w, "v {} {} {}", Num(p.x), Num(p.y), Num(p.z))
 }
 
-/// Writes `body` as the object `body:<name>`: its particles' positions in `x` as vertices,
-/// numbered from `base` (OBJ's 1-based count of the vertices before it in the file), and its
-/// triangles, or for a body without triangles its `springs` as lines.
+/// Where the next body's vertices and texture coordinates start in an OBJ file (1-based:
+/// one more than the count written before it).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Base {
+    /// The next vertex's number.
+    pub(crate) vertex: usize,
+    /// The next texture coordinate's number.
+    pub(crate) uv: usize,
+}
+
+impl Default for Base {
+    fn default() -> Self {
+        Self { vertex: 1, uv: 1 }
+    }
+}
+
+/// Writes `body` as the object `body:<name>`: the vertices it shows at the particles'
+/// positions `x` (a mesh body's are its file's, in their order, with its texture
+/// coordinates), numbered from `base`, and its faces (a mesh body's as written, quads
+/// staying quads), or for a body without faces its `springs` as lines. Returns where the
+/// next body starts.
 pub(crate) fn write_body(
     w: &mut impl Write,
     body: &Body,
     x: &[Vec3],
     springs: &[Spring],
-    base: usize,
-) -> std::io::Result<()> {
+    base: Base,
+) -> std::io::Result<Base> {
     writeln!(w, "o body:{}", body.name)?;
-    for p in &x[body.range.clone()] {
+    let mut points = Vec::new();
+    body.vertices(x, &mut points);
+    for p in &points {
         vertex(w, p)?;
     }
-    let local = |i: u32| i as usize - body.range.start + base;
-    for t in &body.triangles {
-        writeln!(w, "f {} {} {}", local(t[0]), local(t[1]), local(t[2]))?;
+    let uvs = body.skin.as_ref().map_or(&[][..], |s| &s.uvs[..]);
+    for t in uvs {
+        writeln!(w, "vt {} {}", Num(t[0]), Num(t[1]))?;
     }
-    if body.triangles.is_empty() {
-        for s in springs
-            .iter()
-            .filter(|s| body.range.contains(&(s.i as usize)))
-        {
-            writeln!(w, "l {} {}", local(s.i), local(s.j))?;
+    match &body.skin {
+        Some(skin) => {
+            for f in &skin.faces {
+                write!(w, "f")?;
+                for (k, &c) in f.corners.iter().enumerate() {
+                    match &f.uvs {
+                        Some(t) => write!(
+                            w,
+                            " {}/{}",
+                            c as usize + base.vertex,
+                            t[k] as usize + base.uv
+                        )?,
+                        None => write!(w, " {}", c as usize + base.vertex)?,
+                    }
+                }
+                writeln!(w)?;
+            }
+        }
+        None => {
+            let local = |i: u32| i as usize - body.range.start + base.vertex;
+            for t in &body.triangles {
+                writeln!(w, "f {} {} {}", local(t[0]), local(t[1]), local(t[2]))?;
+            }
+            if body.triangles.is_empty() {
+                for s in springs
+                    .iter()
+                    .filter(|s| body.range.contains(&(s.i as usize)))
+                {
+                    writeln!(w, "l {} {}", local(s.i), local(s.j))?;
+                }
+            }
         }
     }
-    Ok(())
+    Ok(Base {
+        vertex: base.vertex + points.len(),
+        uv: base.uv + uvs.len(),
+    })
 }
 
 fn write_frame(
@@ -99,11 +148,11 @@ fn write_frame(
         Num(sim.time())
     )?;
     // OBJ indices are 1-based and count every vertex written so far in the file.
-    let mut base = 1usize;
+    let mut next = Base::default();
     for body in &scene.bodies {
-        write_body(w, body, x, &sim.model().springs, base)?;
-        base += body.range.len();
+        next = write_body(w, body, x, &sim.model().springs, next)?;
     }
+    let mut base = next.vertex;
     for (name, tris) in colliders {
         writeln!(w, "o {name}")?;
         for t in tris {

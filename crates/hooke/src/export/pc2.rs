@@ -6,8 +6,8 @@
 //! The format, all little-endian: a 32-byte header — the 12 bytes `POINTCACHE2\0`, `i32`
 //! version 1, `i32` point count, `f32` start frame, `f32` sampling (frames per sample),
 //! `i32` sample count — then per sample the points as `f32` triples. Sample `k` is frame `k`
-//! of the run (start frame 0, sampling 1). The points are the body's particles in order (the
-//! OBJ's vertices), in metres, +Y up. Blender's OBJ importer turns +Y up into its +Z up on
+//! of the run (start frame 0, sampling 1). The points are the body's vertices in order (the
+//! OBJ's vertices: a body made from a mesh keeps its file's, in their count and order), in metres, +Y up. Blender's OBJ importer turns +Y up into its +Z up on
 //! the object, and the cache, read with the modifier's default axes, follows the object;
 //! Blender's Mesh Cache modifier ignores the header's start frame and puts sample 0 at its
 //! own Frame Start (0 by default, while a timeline starts at 1).
@@ -19,7 +19,6 @@ use crate::error::{Context, Result, bail_output};
 use crate::output::OutputFile;
 use hooke_scene::{Body, Scene};
 use std::io::{Seek, SeekFrom, Write};
-use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 /// The header's first 12 bytes.
@@ -34,7 +33,12 @@ pub struct Pc2Export {
     path: PathBuf,
     file: OutputFile,
     body: String,
-    range: Range<usize>,
+    /// The body's index in the scene.
+    index: usize,
+    /// Reused from frame to frame.
+    points: Vec<hooke_core::Vec3>,
+    /// Points per sample.
+    count: u32,
     samples: u32,
 }
 
@@ -64,7 +68,7 @@ impl Pc2Export {
     /// body's mesh as it is now to the `.obj` beside it.
     pub fn create(path: &Path, body: Option<&str>, scene: &Scene) -> Result<Self> {
         let body = pick(scene, body)?;
-        let points = u32::try_from(body.range.len())
+        let points = u32::try_from(body.vertex_count())
             .ok()
             .filter(|&n| n <= i32::MAX as u32)
             .ok_or_else(|| {
@@ -87,7 +91,7 @@ impl Pc2Export {
                 body.name,
                 path.file_name().unwrap_or_default().to_string_lossy()
             )?;
-            super::obj::write_body(w, body, x, springs, 1)
+            super::obj::write_body(w, body, x, springs, Default::default()).map(|_| ())
         })()
         .with_context(|| format!("cannot write {}", mesh.display()))?;
         obj.commit()?;
@@ -106,7 +110,13 @@ impl Pc2Export {
             path: path.to_path_buf(),
             file,
             body: body.name.clone(),
-            range: body.range.clone(),
+            index: scene
+                .bodies
+                .iter()
+                .position(|b| b.name == body.name)
+                .unwrap_or(0),
+            points: Vec::new(),
+            count: points,
             samples: 0,
         })
     }
@@ -116,10 +126,10 @@ impl crate::Sink for Pc2Export {
     /// Appends frame `frame` of `scene` as the next sample.
     fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
         debug_assert_eq!(frame, u64::from(self.samples));
-        let x = &scene.simulation.particles().x[self.range.clone()];
+        scene.bodies[self.index].vertices(&scene.simulation.particles().x, &mut self.points);
         let w = self.file.writer();
         let mut bytes = [0u8; 12];
-        for p in x {
+        for p in &self.points {
             for (k, c) in super::f32s(p).iter().enumerate() {
                 bytes[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
             }
@@ -146,7 +156,7 @@ impl crate::Sink for Pc2Export {
             samples,
             if samples == 1 { "" } else { "s" },
             self.body,
-            self.range.len(),
+            self.count,
             self.path.with_extension("obj").display()
         ))
     }

@@ -1,10 +1,13 @@
 //! `--export DIR/ --format ply`: one binary little-endian PLY per frame, written with the
 //! `ply-rs-bw` crate (the maintained fork of `ply-rs`).
 //!
-//! `DIR/frame-00000.ply` holds frame 0, and so on: an element `vertex` per particle (vertex
-//! `i` is particle `i`) with `x y z` and a unit normal `nx ny nz` (the area-weighted normal
-//! of its triangles, zero off every surface), and an element `face` with the bodies'
-//! triangles as `vertex_indices`. Colliders do not move and are left out (`--format obj`
+//! `DIR/frame-00000.ply` holds frame 0, and so on: an element `vertex` per vertex the bodies
+//! show, body after body (a generated body's particles in order; a body made from a mesh,
+//! its file's vertices in their count and order) with `x y z` and a unit normal `nx ny nz`
+//! (the area-weighted normal of its triangles, zero off every surface), and an element
+//! `face` with the bodies' faces as `vertex_indices` (a mesh body's as written, quads
+//! staying quads) and, when a mesh has them, each corner's texture coordinates as a list
+//! `texcoord` of `u v` pairs (empty for faces without). Colliders do not move and are left out (`--format obj`
 //! has them). Values are `float`, as renderers read them.
 
 use crate::error::{Context, Result};
@@ -58,11 +61,13 @@ impl PropertyAccess for PlyVertex {
     }
 }
 
-/// A triangle as the PLY writer reads it.
+/// A face as the PLY writer reads it.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PlyFace {
     /// Its corners' vertex indices.
     pub vertex_indices: Vec<i32>,
+    /// Its corners' texture coordinates, `u v` each (empty when it has none).
+    pub texcoord: Vec<f32>,
 }
 
 impl PropertyAccess for PlyFace {
@@ -71,13 +76,19 @@ impl PropertyAccess for PlyFace {
     }
 
     fn set_property(&mut self, name: &str, property: ply_rs_bw::ply::Property) {
-        if let ("vertex_indices", ply_rs_bw::ply::Property::ListInt(v)) = (name, property) {
-            self.vertex_indices = v;
+        match (name, property) {
+            ("vertex_indices", ply_rs_bw::ply::Property::ListInt(v)) => self.vertex_indices = v,
+            ("texcoord", ply_rs_bw::ply::Property::ListFloat(v)) => self.texcoord = v,
+            _ => {}
         }
     }
 
     fn get_list_int(&self, name: &str) -> Option<&[i32]> {
         (name == "vertex_indices").then_some(self.vertex_indices.as_slice())
+    }
+
+    fn get_list_float(&self, name: &str) -> Option<&[f32]> {
+        (name == "texcoord").then_some(self.texcoord.as_slice())
     }
 }
 
@@ -86,11 +97,16 @@ pub struct PlyExport {
     dir: PathBuf,
     /// The folder, held for this run.
     _lock: crate::output::lock::FolderLock,
-    /// The triangles of every body, as particle indices.
+    /// Every body's faces, as indices into the file's vertices.
     faces: Vec<PlyFace>,
+    /// Whether some face has texture coordinates (then every face has the property).
+    textured: bool,
+    /// The faces as triangles, for the normals.
     triangles: Vec<[u32; 3]>,
     /// Buffers reused from frame to frame.
     normals: Vec<Vec3>,
+    points: Vec<Vec3>,
+    body_points: Vec<Vec3>,
     vertices: Vec<PlyVertex>,
     frames: u64,
 }
@@ -100,23 +116,46 @@ impl PlyExport {
     /// an earlier run's frames) for `scene`.
     pub fn new(dir: &Path, scene: &Scene) -> Result<Self> {
         let lock = super::frame_folder(dir, "ply")?;
-        let triangles: Vec<[u32; 3]> = scene
-            .bodies
-            .iter()
-            .flat_map(|b| b.triangles.iter().copied())
-            .collect();
-        let faces = triangles
-            .iter()
-            .map(|t| PlyFace {
-                vertex_indices: t.iter().map(|&i| i as i32).collect(),
-            })
-            .collect();
+        let mut faces = Vec::new();
+        let mut triangles = Vec::new();
+        let mut textured = false;
+        let mut base = 0u32;
+        for body in &scene.bodies {
+            let uvs = body.skin.as_ref().map_or(&[][..], |s| &s.uvs[..]);
+            let corner_uvs = |k: usize| -> Vec<f32> {
+                body.skin
+                    .as_ref()
+                    .and_then(|s| s.faces[k].uvs.as_ref())
+                    .map_or_else(Vec::new, |t| {
+                        t.iter()
+                            .flat_map(|&i| uvs[i as usize].map(|c| c as f32))
+                            .collect()
+                    })
+            };
+            for (k, f) in body.faces().into_iter().enumerate() {
+                let texcoord = corner_uvs(k);
+                textured |= !texcoord.is_empty();
+                faces.push(PlyFace {
+                    vertex_indices: f.iter().map(|&i| (i + base) as i32).collect(),
+                    texcoord,
+                });
+            }
+            triangles.extend(
+                body.face_triangles()
+                    .into_iter()
+                    .map(|t| t.map(|i| i + base)),
+            );
+            base += body.vertex_count() as u32;
+        }
         Ok(Self {
             dir: dir.to_path_buf(),
             _lock: lock,
             faces,
+            textured,
             triangles,
             normals: Vec::new(),
+            points: Vec::new(),
+            body_points: Vec::new(),
             vertices: Vec::new(),
             frames: 0,
         })
@@ -153,6 +192,11 @@ impl PlyExport {
         let list = PropertyType::List(ScalarType::UChar, ScalarType::Int);
         face.properties
             .add(PropertyDef::new("vertex_indices".to_string(), list));
+        if self.textured {
+            let list = PropertyType::List(ScalarType::UChar, ScalarType::Float);
+            face.properties
+                .add(PropertyDef::new("texcoord".to_string(), list));
+        }
         header.elements.add(vertex.clone());
         header.elements.add(face.clone());
         Writer::<PlyVertex>::new().write_header(out, &header)?;
@@ -171,13 +215,22 @@ impl crate::Sink for PlyExport {
     /// Writes frame `frame` of `scene` at its current state.
     fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
         let x = &scene.simulation.particles().x;
-        super::vertex_normals(x, &self.triangles, &mut self.normals);
+        self.points.clear();
+        for body in &scene.bodies {
+            body.vertices(x, &mut self.body_points);
+            self.points.extend_from_slice(&self.body_points);
+        }
+        super::vertex_normals(&self.points, &self.triangles, &mut self.normals);
         self.vertices.clear();
-        self.vertices
-            .extend(x.iter().zip(&self.normals).map(|(p, n)| PlyVertex {
-                x: super::f32s(p),
-                n: super::f32s(n),
-            }));
+        self.vertices.extend(
+            self.points
+                .iter()
+                .zip(&self.normals)
+                .map(|(p, n)| PlyVertex {
+                    x: super::f32s(p),
+                    n: super::f32s(n),
+                }),
+        );
         let path = self.path(frame);
         let mut file = OutputFile::create_named(&path, "--export")?;
         self.write(file.writer(), frame, scene)

@@ -12,7 +12,9 @@
 //! * a chain is a linear `BasisCurves` through its particles, time-sampled the same way;
 //! * loose particles are `Points`.
 //!
-//! A body's points are its particles in order. The colliders are meshes under
+//! A body's points are its particles in order; a body made from a mesh has its file's
+//! vertices in their count and order, its faces as written (quads stay quads) and its
+//! texture coordinates as `primvars:st`, per face corner. The colliders are meshes under
 //! `/World/colliders` where the scene placed them (see [`super::collider_triangles`]); a
 //! moving one has a time-sampled `xformOp:transform` with its pose at each frame. Positions and velocities are
 //! `float` as the schemas declare them, each the `f32` nearest the simulation's `f64`.
@@ -102,6 +104,9 @@ pub struct UsdExport {
     frames: u64,
     /// Seconds between frames.
     frame_time: f64,
+    /// A body's vertex positions and velocities, reused from frame to frame.
+    x: Vec<Vec3>,
+    v: Vec<Vec3>,
 }
 
 impl UsdExport {
@@ -133,6 +138,8 @@ impl UsdExport {
             transforms: vec![String::new(); scene.colliders.len()],
             frames: 0,
             frame_time: scene.every as f64 * scene.simulation.dt(),
+            x: Vec::new(),
+            v: Vec::new(),
         })
     }
 
@@ -190,24 +197,43 @@ impl UsdExport {
 /// A body prim's opening: its type and name, and its attributes that do not change.
 fn opening(prim: &str, body: &hooke_scene::Body) -> Result<String> {
     let mut s = String::new();
-    let n = body.range.len();
+    let n = body.vertex_count();
     match shape(body) {
-        Shape::Mesh(triangles) => {
+        Shape::Mesh(faces) => {
             writeln!(s, "    def Mesh \"{prim}\"\n    {{")?;
             writeln!(s, "        uniform token subdivisionScheme = \"none\"")?;
-            let counts = vec!["3"; triangles.len()].join(", ");
-            writeln!(s, "        int[] faceVertexCounts = [{counts}]")?;
-            let start = body.range.start as u32;
-            let indices: Vec<String> = triangles
-                .iter()
-                .flatten()
-                .map(|&i| (i - start).to_string())
-                .collect();
+            let counts: Vec<String> = faces.iter().map(|f| f.len().to_string()).collect();
+            writeln!(
+                s,
+                "        int[] faceVertexCounts = [{}]",
+                counts.join(", ")
+            )?;
+            let indices: Vec<String> = faces.iter().flatten().map(|i| i.to_string()).collect();
             writeln!(
                 s,
                 "        int[] faceVertexIndices = [{}]",
                 indices.join(", ")
             )?;
+            // A mesh's texture coordinates, per face corner, when every face has them.
+            if let Some(skin) = &body.skin
+                && !skin.faces.is_empty()
+                && skin.faces.iter().all(|f| f.uvs.is_some())
+            {
+                let st: Vec<String> = skin
+                    .faces
+                    .iter()
+                    .flat_map(|f| f.uvs.iter().flatten())
+                    .map(|&t| {
+                        let [u, v] = skin.uvs[t as usize];
+                        format!("({}, {})", F(u as f32), F(v as f32))
+                    })
+                    .collect();
+                writeln!(
+                    s,
+                    "        texCoord2f[] primvars:st = [{}] (interpolation = \"faceVarying\")",
+                    st.join(", ")
+                )?;
+            }
         }
         Shape::Curve => {
             writeln!(s, "    def BasisCurves \"{prim}\"\n    {{")?;
@@ -291,7 +317,8 @@ impl crate::Sink for UsdExport {
     fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
         let p = scene.simulation.particles();
         for (body, stream) in scene.bodies.iter().zip(&mut self.bodies) {
-            let r = body.range.clone();
+            body.vertices(&p.x, &mut self.x);
+            body.vertex_velocities(&p.v, &mut self.v);
             let write = |file: &mut OutputFile, values: &mut dyn Iterator<Item = [f32; 3]>| {
                 let w = file.writer();
                 write!(w, "            {frame}: [")?;
@@ -303,19 +330,13 @@ impl crate::Sink for UsdExport {
                 }
                 w.write_all(b"],\n")
             };
-            let (lo, hi) = p.x[r.clone()].iter().fold(
+            let (lo, hi) = self.x.iter().fold(
                 (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
                 |(lo, hi), x| (lo.inf(x), hi.sup(x)),
             );
             (|| -> std::io::Result<()> {
-                write(
-                    &mut stream.points,
-                    &mut p.x[r.clone()].iter().map(super::f32s),
-                )?;
-                write(
-                    &mut stream.velocities,
-                    &mut p.v[r.clone()].iter().map(super::f32s),
-                )?;
+                write(&mut stream.points, &mut self.x.iter().map(super::f32s))?;
+                write(&mut stream.velocities, &mut self.v.iter().map(super::f32s))?;
                 // The extent holds every point: rounded outwards to f32.
                 let (lo, hi) = (lo.map(|c| outward(c, false)), hi.map(|c| outward(c, true)));
                 write(

@@ -1,6 +1,8 @@
 //! One body's particles, masses and springs: from its springs (`[body.springs]`, a mass per
 //! particle) or from a material (`[body.material]`), and its keyframed pins.
 
+pub(crate) mod mesh;
+
 use crate::error::{BuildError, invalid};
 use crate::generators::Lattice;
 use crate::limits::MAX_PARTICLES;
@@ -15,14 +17,50 @@ pub(crate) struct BuiltBody {
     pub(crate) masses: Vec<f64>,
     pub(crate) springs: Vec<Spring>,
     pub(crate) topology: Topology,
+    /// The surface triangles (indices within the body) of a body made from a mesh; the
+    /// generated shapes' come from their topology.
+    pub(crate) triangles: Option<Vec<[u32; 3]>>,
+    /// The user's mesh, for a body made from one (particle indices within the body).
+    pub(crate) skin: Option<crate::skin::Skin>,
+    /// The pinned particles, within the body.
+    pub(crate) pins: Vec<usize>,
+    /// What building did that the user should hear of.
+    pub(crate) warnings: Vec<String>,
 }
 
-/// Builds body `key` (its particles numbered from `offset`).
+/// Builds body `key` (its particles numbered from `offset`; mesh files found from `base`).
 pub(crate) fn build_body(
     body: &BodySpec,
     key: &str,
     offset: usize,
+    base: &std::path::Path,
 ) -> Result<BuiltBody, BuildError> {
+    let scaled = |s: &[crate::spec::Positive; 3]| Vec3::new(s[0].get(), s[1].get(), s[2].get());
+    match &body.shape {
+        ShapeSpec::Mesh { path, scale, weld } => {
+            return crate::body::mesh::cloth(
+                body,
+                key,
+                offset,
+                base,
+                (path, scaled(scale), weld.map(|w| w.get())),
+            );
+        }
+        ShapeSpec::Solid {
+            path,
+            scale,
+            spacing,
+        } => {
+            return crate::body::mesh::jelly(
+                body,
+                key,
+                offset,
+                base,
+                (path, scaled(scale), spacing.get()),
+            );
+        }
+        _ => {}
+    }
     if let Some(material) = &body.material {
         return material_body(body, material, key, offset);
     }
@@ -34,25 +72,27 @@ pub(crate) fn build_body(
     };
     let mut built = spring_body(body, key, offset)?;
     built.masses = vec![mass.get(); built.local.len()];
+    built.pins = crate::body::mesh::region_pins(body, key, &built.local, None)?;
     Ok(built)
 }
 
-/// A body's keyframed pins (docs/physics.md §1.2): its pinned particles, moved by `motion`.
+/// A body's keyframed pins (docs/physics.md §1.2): its pinned particles `pins` (within
+/// the body), moved by `motion`.
 pub(crate) fn pin_motion(
-    body: &BodySpec,
+    pins: &[usize],
     motion: &crate::spec::MotionSpec,
     key: &str,
     start: usize,
     particles: &Particles,
 ) -> Result<PinMotion, BuildError> {
-    if body.pins.is_empty() {
+    if pins.is_empty() {
         return Err(invalid(
             format!("{key}.pin_motion"),
             "it moves the body's pinned particles, and the body has none: give `pins`",
         ));
     }
     let keys = crate::colliders::keyframes(motion, &format!("{key}.pin_motion"))?;
-    let mut ids: Vec<u32> = body.pins.iter().map(|&p| (start + p) as u32).collect();
+    let mut ids: Vec<u32> = pins.iter().map(|&p| (start + p) as u32).collect();
     ids.sort_unstable();
     ids.dedup();
     Ok(PinMotion::new(ids, &particles.x, keys))
@@ -95,9 +135,10 @@ fn material_body(
     let material = material.resolve(&format!("{key}.material"))?;
     let mut built = spring_body(body, key, offset)?;
     built.masses = material.masses(*size, spacing.get());
+    built.pins = crate::body::mesh::region_pins(body, key, &built.local, None)?;
     let n = built.local.len();
     let mut held = vec![false; n];
-    for &p in body.pins.iter().filter(|&&p| p < n) {
+    for &p in built.pins.iter().filter(|&&p| p < n) {
         held[p] = true;
     }
     let pinned = |p: usize| held[p];
@@ -127,6 +168,7 @@ fn spring_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, B
             spacing.get(),
             Topology::Lattice(*size),
         ),
+        ShapeSpec::Mesh { .. } | ShapeSpec::Solid { .. } => unreachable!("built from a mesh"),
         ShapeSpec::Points { positions } => {
             let local: Vec<Vec3> = positions.iter().map(vec3).collect();
             if body.springs.structural.is_some()
@@ -144,6 +186,10 @@ fn spring_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, B
                 masses: Vec::new(),
                 springs,
                 topology: Topology::Points,
+                triangles: None,
+                skin: None,
+                pins: Vec::new(),
+                warnings: Vec::new(),
             });
         }
     };
@@ -158,6 +204,7 @@ fn spring_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, B
             ShapeSpec::Grid { size, .. } => ("size", format!("{size:?} ({total} particles)")),
             ShapeSpec::Lattice { size, .. } => ("size", format!("{size:?} ({total} particles)")),
             ShapeSpec::Points { positions } => ("positions", format!("{} points", positions.len())),
+            ShapeSpec::Mesh { .. } | ShapeSpec::Solid { .. } => unreachable!("built from a mesh"),
         };
         return Err(invalid(
             format!("{key}.shape.{field}"),
@@ -184,10 +231,15 @@ fn spring_body(body: &BodySpec, key: &str, offset: usize) -> Result<BuiltBody, B
         masses: Vec::new(),
         springs,
         topology,
+        triangles: None,
+        skin: None,
+        pins: Vec::new(),
+        warnings: Vec::new(),
     })
 }
 
-fn pairs(
+/// The explicit `[[body.springs.pairs]]` of a body whose particles are at `local`.
+pub(crate) fn pairs(
     body: &BodySpec,
     key: &str,
     local: &[Vec3],
