@@ -45,6 +45,23 @@ pub struct Skin {
 }
 
 impl Skin {
+    /// The faces and texture coordinates of an OBJ as written, with `vertices` for its
+    /// vertices.
+    pub(crate) fn of_file(mesh: &hooke_collide::PolygonMesh, vertices: Vec<SkinVertex>) -> Self {
+        Self {
+            vertices,
+            faces: mesh
+                .faces
+                .iter()
+                .map(|f| SkinFace {
+                    corners: f.corners.clone(),
+                    uvs: f.uvs.clone(),
+                })
+                .collect(),
+            uvs: mesh.texcoords.clone(),
+        }
+    }
+
     /// Each vertex's position from the particles' `x`, into `out` (cleared first).
     pub fn positions(&self, x: &[Vec3], out: &mut Vec<Vec3>) {
         out.clear();

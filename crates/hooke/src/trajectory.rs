@@ -3,7 +3,7 @@
 
 use crate::error::{Context, Result};
 use crate::output::OutputFile;
-use hooke_core::{Num, Particles};
+use hooke_core::{Num, Particles, Vec3};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -30,20 +30,8 @@ impl TrajectoryWriter {
 
     /// Appends one frame of particles at `time` seconds.
     pub fn append(&mut self, frame: u64, time: f64, p: &Particles) -> Result<()> {
-        let w = self.file.writer();
         for (i, (x, v)) in p.x.iter().zip(&p.v).enumerate() {
-            writeln!(
-                w,
-                "{frame},{},{i},{},{},{},{},{},{}",
-                Num(time),
-                Num(x.x),
-                Num(x.y),
-                Num(x.z),
-                Num(v.x),
-                Num(v.y),
-                Num(v.z)
-            )
-            .with_context(|| format!("cannot write {}", self.path.display()))?;
+            self.row((frame, time, i), x, v)?;
         }
         Ok(())
     }
@@ -65,27 +53,31 @@ impl TrajectoryWriter {
         }
         let (mut x, mut v) = (Vec::new(), Vec::new());
         let mut row = 0usize;
-        let w = self.file.writer();
         for body in &scene.bodies {
             body.vertices(&p.x, &mut x);
             body.vertex_velocities(&p.v, &mut v);
             for (x, v) in x.iter().zip(&v) {
-                writeln!(
-                    w,
-                    "{frame},{},{row},{},{},{},{},{},{}",
-                    Num(time),
-                    Num(x.x),
-                    Num(x.y),
-                    Num(x.z),
-                    Num(v.x),
-                    Num(v.y),
-                    Num(v.z)
-                )
-                .with_context(|| format!("cannot write {}", self.path.display()))?;
+                self.row((frame, time, row), x, v)?;
                 row += 1;
             }
         }
         Ok(())
+    }
+
+    /// One row: frame, time, the row's index in the frame, position and velocity.
+    fn row(&mut self, (frame, time, i): (u64, f64, usize), x: &Vec3, v: &Vec3) -> Result<()> {
+        writeln!(
+            self.file.writer(),
+            "{frame},{},{i},{},{},{},{},{},{}",
+            Num(time),
+            Num(x.x),
+            Num(x.y),
+            Num(x.z),
+            Num(v.x),
+            Num(v.y),
+            Num(v.z)
+        )
+        .with_context(|| format!("cannot write {}", self.path.display()))
     }
 }
 

@@ -3,7 +3,7 @@
 //! file's vertices to the particles that the outputs use to hand them back in order.
 
 use crate::error::{BuildError, invalid};
-use crate::skin::{Skin, SkinFace, SkinVertex};
+use crate::skin::{Skin, SkinVertex};
 use hooke_collide::PolygonMesh;
 use hooke_core::{Num, Vec3};
 use std::collections::HashMap;
@@ -175,23 +175,13 @@ pub(crate) fn sheet(
         })
         .collect();
     let triangles = polygons.iter().flat_map(|p| split(p, &local)).collect();
-    let skin = Skin {
-        vertices: (0..n)
-            .map(|v| match particle_of[v] {
-                Some(p) => SkinVertex::Particle(p),
-                None => SkinVertex::Fixed(mesh.positions[v].component_mul(&scale)),
-            })
-            .collect(),
-        faces: mesh
-            .faces
-            .iter()
-            .map(|f| SkinFace {
-                corners: f.corners.clone(),
-                uvs: f.uvs.clone(),
-            })
-            .collect(),
-        uvs: mesh.texcoords.clone(),
-    };
+    let vertices = (0..n)
+        .map(|v| match particle_of[v] {
+            Some(p) => SkinVertex::Particle(p),
+            None => SkinVertex::Fixed(mesh.positions[v].component_mul(&scale)),
+        })
+        .collect();
+    let skin = Skin::of_file(&mesh, vertices);
     Ok(Sheet {
         local,
         file,

@@ -9,7 +9,7 @@
 use crate::body::mesh::sheet::split;
 use crate::error::{BuildError, invalid};
 use crate::generators::Lattice;
-use crate::skin::{Skin, SkinFace, SkinVertex};
+use crate::skin::{Skin, SkinVertex};
 use hooke_collide::PolygonMesh;
 use hooke_core::{SpringKind, Vec3};
 use std::collections::HashMap;
@@ -259,18 +259,7 @@ pub(crate) fn fill(
             }
         })
         .collect();
-    let skin = Skin {
-        vertices,
-        faces: mesh
-            .faces
-            .iter()
-            .map(|f| SkinFace {
-                corners: f.corners.clone(),
-                uvs: f.uvs.clone(),
-            })
-            .collect(),
-        uvs: mesh.texcoords.clone(),
-    };
+    let skin = Skin::of_file(mesh, vertices);
     Ok(Filled {
         local,
         springs,
