@@ -117,6 +117,10 @@ fn a_grid_given_as_an_obj_drapes_as_the_grid() {
     use hooke_core::Integrator::{Symplectic, Vbd};
     for (integrator, dt) in [(Symplectic, 2.5e-4), (Vbd, 1.0 / 60.0)] {
         let [(low_g, c_g), (low_m, c_m)] = tablecloth_both_ways(integrator, dt);
+        eprintln!(
+            "{integrator:?}: lowest {low_g:.4} (grid) {low_m:.4} (mesh); centroids {:.4} apart",
+            (c_g - c_m).norm()
+        );
         assert!(
             (low_g - low_m).abs() < 0.01,
             "{integrator:?}: lowest {low_g} (grid) vs {low_m} (mesh)"
@@ -220,6 +224,10 @@ response = { kind = "restitution", cr = 0.0, friction = 0.5 }
 fn the_triangulation_does_not_change_the_fabric() {
     let (low_c, c_c, a_c) = round_cloth(20);
     let (low_f, c_f, a_f) = round_cloth(40);
+    eprintln!(
+        "lowest {low_c:.4} {low_f:.4}; centroids {:.4} apart; area {a_c:.4} {a_f:.4} m²",
+        (c_c - c_f).norm()
+    );
     assert!((low_c - low_f).abs() < 0.02, "lowest {low_c} vs {low_f} m");
     assert!((c_c - c_f).norm() < 0.01, "centroid {c_c:?} vs {c_f:?}");
     assert!(
@@ -294,6 +302,7 @@ material = { density = 0.2, stretch = 2000.0, shear = 100.0, bending = 2e-3, dam
     let chord = at(nx - 1) - at(1);
     let angle = (-chord.y).atan2(chord.x).to_degrees();
     let exact = crate::material::elastica_chord(b, q, 2.0 * c);
+    eprintln!("chord {angle:.3}° against the elastica's {exact:.3}°");
     assert!(
         (angle - exact).abs() < 3.0,
         "chord {angle}° vs elastica {exact}°"
@@ -430,6 +439,7 @@ response = { kind = "restitution", cr = 0.0, friction = 0.5 }
         .fold(0.0, f64::max);
     assert!(fastest < 0.05, "not at rest: {fastest} m/s");
     let now = surface_volume(&scene);
+    eprintln!("volume {rest:.5} → {now:.5} m³; lowest surface {lowest_surface:.5} m");
     assert!(
         (now / rest - 1.0).abs() < 0.02,
         "volume {now} m³ at rest vs {rest} m³"
