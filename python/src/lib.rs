@@ -166,6 +166,9 @@ impl Inner {
     }
 }
 
+/// A body as shown: its vertices and its triangles.
+type Shown<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>);
+
 /// A read-only numpy array of shape `(N, 3)` holding the vectors `v`.
 fn matrix<'py>(py: Python<'py>, v: &[Vec3]) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let values: Vec<f64> = v.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
@@ -353,11 +356,7 @@ impl Simulation {
     /// array of its vertices now and a `(T, 3)` int64 array of rows of it. A body made from a
     /// mesh has its file's vertices in their count and order (its faces as fans of
     /// triangles); any other, its particles and surface triangles.
-    fn mesh<'py>(
-        &self,
-        py: Python<'py>,
-        name: &str,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>)> {
+    fn mesh<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Shown<'py>> {
         let inner = self.lock()?;
         let scene = &inner.scene;
         let Some(body) = scene.bodies.iter().find(|b| b.name == name) else {
