@@ -154,31 +154,14 @@ pub fn parse_obj(
         };
         match words.next() {
             Some("v") => {
-                let coordinates: Vec<&str> = words.take(3).collect();
-                if coordinates.len() < 3 {
-                    return Err(bad("a vertex needs x, y and z".into()));
-                }
-                for w in coordinates {
-                    match w.parse::<f64>() {
-                        Ok(x) if x.abs() <= SANE_BOUND => {}
-                        Ok(x) if x.is_finite() => {
-                            return Err(bad(format!(
-                                "vertex coordinate {} is beyond {} m, the extent of a \
-                                 simulated world",
-                                hooke_core::Num(x),
-                                hooke_core::Num(SANE_BOUND)
-                            )));
-                        }
-                        Ok(_) => {
-                            return Err(MeshError::NonFinite {
-                                path: path.to_path_buf(),
-                                line: n + 1,
-                                text: excerpt(line.trim()),
-                            });
-                        }
-                        Err(_) => return Err(bad(format!("'{}' is not a number", excerpt(w)))),
-                    }
-                }
+                coordinates(
+                    words.take(3),
+                    3,
+                    "vertex",
+                    "a vertex needs x, y and z",
+                    path,
+                    (n + 1, line),
+                )?;
             }
             Some("f") => {
                 let corners: Vec<&str> = words.collect();
@@ -190,13 +173,7 @@ pub fn parse_obj(
                 }
                 for c in corners {
                     let index = c.split('/').next().unwrap_or("");
-                    let valid = match index.parse::<i64>() {
-                        Ok(i) if i > 0 => i as usize <= vertices,
-                        // Negative indices count back from the vertices read so far.
-                        Ok(i) if i < 0 => i.unsigned_abs() as usize <= vertices,
-                        _ => false,
-                    };
-                    if !valid {
+                    if resolve(index, vertices).is_none() {
                         return Err(bad(format!(
                             "face vertex '{}' does not name one of the file's {vertices} vertices",
                             excerpt(c)
@@ -261,6 +238,60 @@ pub fn parse_obj(
         });
     }
     Ok(parts)
+}
+
+/// A 1-based OBJ index among `count` items (negative ones count back from the last),
+/// 0-based; `None` when it names none of them.
+pub(crate) fn resolve(word: &str, count: usize) -> Option<u32> {
+    let i = word.parse::<i64>().ok()?;
+    let k = if i > 0 && i as usize <= count {
+        i as usize - 1
+    } else if i < 0 && i.unsigned_abs() as usize <= count {
+        count - i.unsigned_abs() as usize
+    } else {
+        return None;
+    };
+    u32::try_from(k).ok()
+}
+
+/// The first `need` numbers of a `what` statement (`vertex`: `v x y z`), each finite and
+/// within the world's extent; `needs` says what is missing when there are fewer. Errors
+/// name `path` and the statement's 1-based line, echoing its text.
+pub(crate) fn coordinates<'a>(
+    words: impl Iterator<Item = &'a str>,
+    need: usize,
+    what: &str,
+    needs: &str,
+    path: &Path,
+    (line, text): (usize, &str),
+) -> Result<Vec<f64>, MeshError> {
+    let bad = |reason: String| MeshError::Line {
+        path: path.to_path_buf(),
+        line,
+        reason,
+        text: excerpt(text.trim()),
+    };
+    let words: Vec<&str> = words.collect();
+    if words.len() < need {
+        return Err(bad(needs.to_string()));
+    }
+    words
+        .into_iter()
+        .map(|w| match w.parse::<f64>() {
+            Ok(x) if x.abs() <= SANE_BOUND => Ok(x),
+            Ok(x) if x.is_finite() => Err(bad(format!(
+                "{what} coordinate {} is beyond {} m, the extent of a simulated world",
+                hooke_core::Num(x),
+                hooke_core::Num(SANE_BOUND)
+            ))),
+            Ok(_) => Err(MeshError::NonFinite {
+                path: path.to_path_buf(),
+                line,
+                text: excerpt(text.trim()),
+            }),
+            Err(_) => Err(bad(format!("'{}' is not a number", excerpt(w)))),
+        })
+        .collect()
 }
 
 /// Characters of a line echoed in an error.

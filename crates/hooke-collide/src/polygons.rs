@@ -7,8 +7,8 @@
 //! indices the faces name, which a body must keep to hand its vertices back in the user's
 //! order, are read from the same lines as the checks that name a line in their errors.
 
-use crate::obj::{MeshError, excerpt};
-use hooke_core::{SANE_BOUND, Vec3};
+use crate::obj::{MeshError, coordinates, excerpt, resolve};
+use hooke_core::Vec3;
 use std::io::Cursor;
 use std::path::Path;
 
@@ -76,12 +76,14 @@ impl PolygonMesh {
                             "more than {limit} vertices, the most a body may have"
                         )));
                     }
-                    let p = coordinates(words.take(3), 3, path, n + 1, line)?;
+                    let needs = "a vertex needs x, y and z";
+                    let p = coordinates(words.take(3), 3, "vertex", needs, path, (n + 1, line))?;
                     mesh.positions.push(Vec3::new(p[0], p[1], p[2]));
                     mesh.position_lines.push(n + 1);
                 }
                 Some("vt") => {
-                    let p = coordinates(words.take(2), 1, path, n + 1, line)?;
+                    let needs = "a texture coordinate needs u";
+                    let p = coordinates(words.take(2), 1, "texture", needs, path, (n + 1, line))?;
                     mesh.texcoords
                         .push([p[0], p.get(1).copied().unwrap_or(0.0)]);
                 }
@@ -194,63 +196,6 @@ fn group(groups: &mut Vec<String>, name: &str) -> u32 {
             (groups.len() - 1) as u32
         }
     }
-}
-
-/// A 1-based (or negative, counting back) OBJ index among `count` items so far, 0-based.
-fn resolve(word: &str, count: usize) -> Option<u32> {
-    let i = word.parse::<i64>().ok()?;
-    let k = if i > 0 && i as usize <= count {
-        i as usize - 1
-    } else if i < 0 && i.unsigned_abs() as usize <= count {
-        count - i.unsigned_abs() as usize
-    } else {
-        return None;
-    };
-    u32::try_from(k).ok()
-}
-
-/// At least `need` finite numbers within the world's extent.
-fn coordinates<'a>(
-    words: impl Iterator<Item = &'a str>,
-    need: usize,
-    path: &Path,
-    line: usize,
-    text: &str,
-) -> Result<Vec<f64>, MeshError> {
-    let bad = |reason: String| MeshError::Line {
-        path: path.to_path_buf(),
-        line,
-        reason,
-        text: excerpt(text.trim()),
-    };
-    let mut out = Vec::new();
-    for w in words {
-        match w.parse::<f64>() {
-            Ok(x) if x.abs() <= SANE_BOUND => out.push(x),
-            Ok(x) if x.is_finite() => {
-                return Err(bad(format!(
-                    "coordinate {} is beyond {} m, the extent of a simulated world",
-                    hooke_core::Num(x),
-                    hooke_core::Num(SANE_BOUND)
-                )));
-            }
-            Ok(_) => {
-                return Err(MeshError::NonFinite {
-                    path: path.to_path_buf(),
-                    line,
-                    text: excerpt(text.trim()),
-                });
-            }
-            Err(_) => return Err(bad(format!("'{}' is not a number", excerpt(w)))),
-        }
-    }
-    if out.len() < need {
-        return Err(bad(format!(
-            "expected {need} coordinates, found {}",
-            out.len()
-        )));
-    }
-    Ok(out)
 }
 
 #[cfg(test)]

@@ -32,13 +32,7 @@ pub(crate) fn body_surface(
     } else if let ShapeSpec::Mesh { .. } = body.shape {
         // As a grid's: at most a quarter of the shortest edge, so that no two neighbours
         // start within each other's thickness, however irregular the mesh.
-        let rest = |i: u32| local[i as usize - particles.start];
-        let shortest = triangles
-            .iter()
-            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
-            .map(|(a, b)| (rest(a) - rest(b)).norm())
-            .fold(f64::INFINITY, f64::min);
-        DEFAULT_CLOTH_THICKNESS.min(0.25 * shortest)
+        DEFAULT_CLOTH_THICKNESS.min(0.25 * shortest_edge(local, particles.start, &triangles))
     } else {
         default_thickness(&body.shape)
     };
@@ -66,14 +60,7 @@ pub(crate) fn body_surface(
         friction: body.friction.map_or(DEFAULT_SURFACE_FRICTION, |f| f.get()),
     };
     if thickness > 0.0 && self_collision && !surface.triangles.is_empty() {
-        // Measured on the rest shape, which is what the springs keep.
-        let start = surface.particles.start;
-        let rest = |i: u32| local[i as usize - start];
-        let shortest = surface
-            .edges()
-            .iter()
-            .map(|&[a, b]| (rest(a) - rest(b)).norm())
-            .fold(f64::INFINITY, f64::min);
+        let shortest = shortest_edge(local, surface.particles.start, &surface.triangles);
         if thickness >= 0.5 * shortest {
             return Err(invalid(
                 format!("{key}.thickness"),
@@ -87,6 +74,17 @@ pub(crate) fn body_surface(
         }
     }
     Ok(surface)
+}
+
+/// The shortest edge of `triangles` (particle indices, the body's first being `start`) in
+/// the rest shape `local`, which is what the springs keep.
+fn shortest_edge(local: &[Vec3], start: usize, triangles: &[[u32; 3]]) -> f64 {
+    let rest = |i: u32| local[i as usize - start];
+    triangles
+        .iter()
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .map(|(a, b)| (rest(a) - rest(b)).norm())
+        .fold(f64::INFINITY, f64::min)
 }
 
 impl SceneSpec {

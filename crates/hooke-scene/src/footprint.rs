@@ -68,6 +68,22 @@ pub struct Footprint {
 }
 
 impl Footprint {
+    /// Adds a body of `particles`, `springs` and `surface_particles`, noting its bytes
+    /// under `key`.
+    fn add_body(&mut self, key: String, particles: u64, springs: u64, surface_particles: u64) {
+        self.particles = self.particles.saturating_add(particles);
+        self.springs = self.springs.saturating_add(springs);
+        self.surface_particles = self.surface_particles.saturating_add(surface_particles);
+        let bytes = Footprint {
+            particles,
+            springs,
+            surface_particles,
+            ..Footprint::default()
+        }
+        .bytes();
+        self.note(key, bytes);
+    }
+
     /// The estimated peak memory in bytes.
     pub fn bytes(&self) -> u64 {
         self.particles
@@ -108,17 +124,7 @@ impl SceneSpec {
             let key = format!("body[{b}] '{}'", body.name);
             if let Some(path) = body.shape.mesh_path() {
                 let (particles, springs) = mesh_estimate(&body.shape, path, base);
-                f.particles = f.particles.saturating_add(particles);
-                f.springs = f.springs.saturating_add(springs);
-                f.surface_particles = f.surface_particles.saturating_add(particles);
-                let bytes = Footprint {
-                    particles,
-                    springs,
-                    surface_particles: particles,
-                    ..Footprint::default()
-                }
-                .bytes();
-                f.note(format!("{key}.shape.path"), bytes);
+                f.add_body(format!("{key}.shape.path"), particles, springs, particles);
                 continue;
             }
             let (lattice, size_key) = match &body.shape {
@@ -171,22 +177,12 @@ impl SceneSpec {
                 && body.thickness.is_none_or(|t| t.get() > 0.0))
                 || (has_triangles && self.simulation.air.is_some());
             let surface_particles = if surface { particles } else { 0 };
-            f.particles = f.particles.saturating_add(particles);
-            f.springs = f.springs.saturating_add(springs);
-            f.surface_particles = f.surface_particles.saturating_add(surface_particles);
-            let bytes = Footprint {
-                particles,
-                springs,
-                surface_particles,
-                ..Footprint::default()
-            }
-            .bytes();
             let key = if body.springs.pairs.len() as u64 * 2 > springs {
                 format!("{key}.springs.pairs")
             } else {
                 format!("{key}.shape.{size_key}")
             };
-            f.note(key, bytes);
+            f.add_body(key, particles, springs, surface_particles);
         }
         if let Some(field) = &self.force_field {
             let r = field.resolution as u64;

@@ -64,14 +64,9 @@ pub(crate) fn build_body(
     if let Some(material) = &body.material {
         return material_body(body, material, key, offset);
     }
-    let Some(mass) = body.mass else {
-        return Err(invalid(
-            format!("{key}.mass"),
-            "missing: give `mass` (kg per particle) and `springs`, or a `[body.material]`",
-        ));
-    };
+    let mass = need_mass(body, key)?;
     let mut built = spring_body(body, key, offset)?;
-    built.masses = vec![mass.get(); built.local.len()];
+    built.masses = vec![mass; built.local.len()];
     built.pins = crate::body::mesh::region_pins(body, key, &built.local, None)?;
     Ok(built)
 }
@@ -98,13 +93,18 @@ pub(crate) fn pin_motion(
     Ok(PinMotion::new(ids, &particles.x, keys))
 }
 
-/// A grid given as a material: its masses and springs derived for its spacing.
-fn material_body(
-    body: &BodySpec,
-    material: &crate::spec::MaterialSpec,
-    key: &str,
-    offset: usize,
-) -> Result<BuiltBody, BuildError> {
+/// A body's `mass` per particle, which a body without a material must give.
+pub(crate) fn need_mass(body: &BodySpec, key: &str) -> Result<f64, BuildError> {
+    body.mass.map(|m| m.get()).ok_or_else(|| {
+        invalid(
+            format!("{key}.mass"),
+            "missing: give `mass` (kg per particle) and `springs`, or a `[body.material]`",
+        )
+    })
+}
+
+/// Refuses `mass` and `springs` beside a material, which gives both.
+pub(crate) fn refuse_mass_and_springs(body: &BodySpec, key: &str) -> Result<(), BuildError> {
     let given: Vec<&str> = [
         ("mass", body.mass.is_some()),
         ("springs", !body.springs.is_empty()),
@@ -114,7 +114,7 @@ fn material_body(
     .map(|(name, _)| *name)
     .collect();
     if !given.is_empty() {
-        return Err(invalid(
+        Err(invalid(
             format!("{key}.material"),
             format!(
                 "a material gives the masses and springs: remove {} (or the material)",
@@ -124,8 +124,20 @@ fn material_body(
                     .collect::<Vec<_>>()
                     .join(" and ")
             ),
-        ));
+        ))
+    } else {
+        Ok(())
     }
+}
+
+/// A grid given as a material: its masses and springs derived for its spacing.
+fn material_body(
+    body: &BodySpec,
+    material: &crate::spec::MaterialSpec,
+    key: &str,
+    offset: usize,
+) -> Result<BuiltBody, BuildError> {
+    refuse_mass_and_springs(body, key)?;
     let ShapeSpec::Grid { size, spacing } = &body.shape else {
         return Err(invalid(
             format!("{key}.material"),

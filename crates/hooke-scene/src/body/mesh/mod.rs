@@ -6,7 +6,7 @@ pub(crate) mod membrane;
 pub(crate) mod sheet;
 pub(crate) mod solid;
 
-use crate::body::BuiltBody;
+use crate::body::{BuiltBody, need_mass, refuse_mass_and_springs};
 use crate::error::{BuildError, invalid};
 use crate::limits::MAX_PARTICLES;
 use crate::material::Material;
@@ -126,25 +126,6 @@ pub(crate) fn jelly(
         warnings: Vec::new(),
         local: filled.local,
     })
-}
-
-fn need_mass(body: &BodySpec, key: &str) -> Result<f64, BuildError> {
-    body.mass.map(|m| m.get()).ok_or_else(|| {
-        invalid(
-            format!("{key}.mass"),
-            "missing: give `mass` (kg per particle) and `springs`, or a `[body.material]`",
-        )
-    })
-}
-
-fn refuse_mass_and_springs(body: &BodySpec, key: &str) -> Result<(), BuildError> {
-    if body.mass.is_some() || !body.springs.is_empty() {
-        return Err(invalid(
-            format!("{key}.material"),
-            "a material gives the masses and springs: remove `mass` and `springs` (or the material)",
-        ));
-    }
-    Ok(())
 }
 
 fn spring(
