@@ -43,18 +43,27 @@ impl SceneSpec {
     ) -> Result<(), BuildError> {
         let particles = &mut out.particles;
         let start = particles.len();
-        // Checked before anything is allocated.
-        if particle_count(&body.shape)
-            .and_then(|n| n.checked_add(start))
-            .is_none_or(|n| n > MAX_PARTICLES)
-        {
-            return Err(invalid(
-                format!("{key}.shape"),
-                format!("the scene would have more than {MAX_PARTICLES} particles"),
-            ));
+        let too_many = |count: Option<usize>| {
+            count
+                .and_then(|n| n.checked_add(start))
+                .is_none_or(|n| n > MAX_PARTICLES)
+                .then(|| {
+                    invalid(
+                        format!("{key}.shape"),
+                        format!("the scene would have more than {MAX_PARTICLES} particles"),
+                    )
+                })
+        };
+        // Checked before anything is allocated; a mesh's count is known once it is read
+        // (which is bounded on its own), and checked then with the bodies before it.
+        if let Some(e) = too_many(particle_count(&body.shape)) {
+            return Err(e);
         }
         let built = build_body(body, key, particles.len(), base)?;
         let n = built.local.len();
+        if let Some(e) = too_many(Some(n)) {
+            return Err(e);
+        }
         place_particles(body, key, (&built.local, &built.masses), particles)?;
         for (k, &pin) in built.pins.iter().enumerate() {
             if pin >= n {
