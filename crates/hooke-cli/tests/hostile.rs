@@ -405,7 +405,7 @@ fn a_block_descent_bench_splits_its_time_into_parts_that_sum_to_the_whole() {
 #[test]
 fn an_interrupt_stops_a_newton_step_under_way() {
     let dir = scratch("newton-interrupt");
-    let child = spawn(
+    let mut child = spawn(
         &[
             "run",
             "cloth-table",
@@ -425,17 +425,14 @@ fn an_interrupt_stops_a_newton_step_under_way() {
     // Frame 0 is written before the first step starts; give the step time to be under way.
     wait_for("the trajectory", || !temporaries(&dir).is_empty());
     std::thread::sleep(std::time::Duration::from_secs(2));
-    let asked = std::time::Instant::now();
     interrupt(&child);
+    // The project's bound for a hung process, not a slow machine (`wait_for`'s): the step
+    // itself would take hours; the interrupt is seen within a few products.
+    wait_for("the run to stop after the interrupt", || {
+        child.try_wait().unwrap().is_some()
+    });
     let out = child.wait_with_output().unwrap();
-    let waited = asked.elapsed();
     assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
-    // The project's bound for a hung process, not a slow machine (as `wait_for`'s): the
-    // step itself would take hours; the interrupt is seen within a few products.
-    assert!(
-        waited.as_secs() < 300,
-        "stopped {waited:?} after the interrupt"
-    );
     let csv = std::fs::read_to_string(dir.join("t.csv")).unwrap();
     assert!(csv.lines().count() > 1, "frame 0 was kept");
     let _ = std::fs::remove_dir_all(&dir);
