@@ -10,6 +10,7 @@ mod common;
 mod conservation;
 mod contact;
 mod determinism;
+mod drape;
 mod friction;
 mod images;
 mod large_steps;

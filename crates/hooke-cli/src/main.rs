@@ -6,6 +6,7 @@ mod advice;
 mod bench;
 mod check;
 mod convert;
+mod drape;
 mod picture;
 mod report;
 mod risks;
@@ -57,6 +58,10 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// Cusick's drape test (BS 5058): a disc of MATERIAL on a round pedestal, repeated;
+    /// prints the drape coefficient and node counts, or with --fit-dc the bending rigidity
+    /// that gives a measured coefficient.
+    Drape(drape::DrapeArgs),
     /// List the built-in scenes.
     Scenes,
     /// Print a built-in scene as TOML (`hooke run` accepts it and reproduces the same run).
@@ -289,6 +294,7 @@ fn dispatch(command: Command) -> Result<ExitCode> {
         Command::Render(args) => picture::render(&args),
         Command::Demo { out, view } => picture::demo(&out, &view.view()),
         Command::Report { dir, quick } => report::report(&dir, quick),
+        Command::Drape(args) => Ok(drape::drape(&args)?),
         Command::Scenes => {
             for (name, make) in hooke_scene::builtin::BUILTINS {
                 println!("{name:<14} {}", make().description);

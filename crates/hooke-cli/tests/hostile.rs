@@ -499,3 +499,59 @@ fn check_recommends_an_integrator_for_any_step_and_names_the_bodies_it_promises(
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `hooke drape`'s bad inputs: an unknown fabric, a size the standard does not name, a
+/// coefficient outside 0–1, no repeats, a material file with a wrong key or a missing one,
+/// a specimen mesh that is not the meter's disc; each refused before any run, naming what
+/// was wrong, and no picture written.
+#[test]
+fn the_drape_meter_refuses_what_it_cannot_measure() {
+    let dir = scratch("drape-bad");
+    refused(
+        &dir,
+        &["drape", "velvet"],
+        &["velvet", "not a preset", "cotton"],
+    );
+    refused(
+        &dir,
+        &["drape", "cotton", "--size", "25"],
+        &["24, 30 or 36 cm", "25"],
+    );
+    refused(
+        &dir,
+        &["drape", "cotton", "--fit-dc", "1.5"],
+        &["--fit-dc", "1.5"],
+    );
+    refused(&dir, &["drape", "cotton", "--repeats", "0"], &["--repeats"]);
+    refused(&dir, &["drape", "cotton", "--dt=0"], &["--dt", "above 0"]);
+    write(
+        &dir,
+        "typo.toml",
+        "[material]\ndensity = 0.15\nstrech = 1000.0\n",
+    );
+    refused(&dir, &["drape", "typo.toml"], &["typo.toml", "strech"]);
+    write(
+        &dir,
+        "short.toml",
+        "[material]\ndensity = 0.15\nstretch = 1000.0\n",
+    );
+    refused(&dir, &["drape", "short.toml"], &["shear"]);
+    write(
+        &dir,
+        "square.obj",
+        "v 0 0 0\nv 0.3 0 0\nv 0.3 0 0.3\nv 0 0 0.3\nf 1 2 3 4\n",
+    );
+    refused(
+        &dir,
+        &[
+            "drape",
+            "cotton",
+            "--mesh",
+            "square.obj",
+            "--top",
+            "top.png",
+        ],
+        &["square.obj", "disc 30 cm across"],
+    );
+    assert!(!dir.join("top.png").exists());
+}

@@ -140,6 +140,42 @@ pub fn round_cloth_obj() -> String {
     )
 }
 
+/// Spacing of the drape meter's specimens' rings, metres: 1 cm, two thirds of the lightest
+/// preset's bending length (silk, 1.2 cm), a seventh of a fold's width.
+pub const DRAPE_RING_SPACING: f64 = 0.01;
+
+/// A drape test specimen (Cusick's meter, BS 5058, ISO 9073-9): a disc `diameter` metres
+/// across, in the x-z plane, of irregular triangles on rings about `spacing` apart.
+pub fn drape_disc_obj(diameter: f64, spacing: f64) -> String {
+    let rings = ((0.5 * diameter / spacing).round() as usize).max(2);
+    let (v, f) = disc(0.5 * diameter, rings, 11);
+    obj(
+        &format!(
+            "drape test specimen, {} cm across, irregular triangles on {rings} rings",
+            diameter * 100.0
+        ),
+        &v,
+        None,
+        &f,
+        &[],
+    )
+}
+
+/// `builtin:drape-24.obj`: [`drape_disc_obj`] 24 cm across.
+pub fn drape_24_obj() -> String {
+    drape_disc_obj(0.24, DRAPE_RING_SPACING)
+}
+
+/// `builtin:drape-30.obj`: [`drape_disc_obj`] 30 cm across (the standard specimen).
+pub fn drape_30_obj() -> String {
+    drape_disc_obj(0.30, DRAPE_RING_SPACING)
+}
+
+/// `builtin:drape-36.obj`: [`drape_disc_obj`] 36 cm across.
+pub fn drape_36_obj() -> String {
+    drape_disc_obj(0.36, DRAPE_RING_SPACING)
+}
+
 /// A rectangle of quads in the x-y plane, `nx × ny` vertices `h` apart, hanging down from
 /// `y = 0`; faces row by row from the top.
 /// Vertices, one texture coordinate per vertex, and faces.

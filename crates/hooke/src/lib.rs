@@ -37,6 +37,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod drape;
 pub mod draw;
 pub mod driver;
 mod error;
