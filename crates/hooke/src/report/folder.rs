@@ -66,6 +66,12 @@ fn names(scenes: &[&str]) -> Vec<String> {
     for name in scenes {
         out.extend(["still", "golden", "diff", "strain"].map(|k| scene_file(name, k)));
     }
+    out.extend(
+        hooke_scene::material::PRESETS
+            .iter()
+            .map(|p| super::drape::drape_file(p.name)),
+    );
+    out.push(super::drape::SWEEP_FILE.into());
     out
 }
 

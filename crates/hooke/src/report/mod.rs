@@ -9,6 +9,7 @@
 
 mod convergence;
 pub mod crossings;
+mod drape;
 mod energy;
 mod folder;
 mod machine;
@@ -57,6 +58,8 @@ struct Report {
     energy: Vec<energy::EnergyRun>,
     scenes: Vec<scenes::SceneCheck>,
     worlds: Vec<worlds::WorldRun>,
+    /// The drape test (none with `--quick`).
+    drape: Option<drape::Drape>,
     determinism: Vec<machine::Hashes>,
     speed: machine::Speed,
     /// Wall seconds each section took here.
@@ -81,13 +84,14 @@ pub fn write(dir: &Path, options: &Options) -> Result<Outcome> {
     folder::check(dir, &checked)?;
     let mut files = folder::Pending::default();
     // As many steps as ticks: two convergence sweeps per integrator, the closed forms, the
-    // energy runs (one per built-in), the scenes, the worlds, the three determinism runs,
+    // energy runs (one per built-in), the scenes, the worlds, the drape test's runs, the three determinism runs,
     // the speed.
     let total = 2 * hooke_core::Integrator::ALL.len()
         + 1
         + hooke_scene::builtin::BUILTINS.len()
         + checked.len()
         + references::WORLDS.len()
+        + drape::ticks(quick)
         + 3
         + 1;
     let total = total as u64;
@@ -114,6 +118,8 @@ pub fn write(dir: &Path, options: &Options) -> Result<Outcome> {
     lap("scenes");
     let worlds = worlds::runs(quick, &references, &mut tick)?;
     lap("worlds");
+    let drape = drape::runs(quick, &mut files, &mut tick)?;
+    lap("drape");
     let determinism = machine::determinism(quick, &mut tick)?;
     lap("determinism");
     let speed = machine::speed(quick)?;
@@ -131,6 +137,7 @@ pub fn write(dir: &Path, options: &Options) -> Result<Outcome> {
         energy,
         scenes,
         worlds,
+        drape,
         determinism,
         speed,
         seconds,
@@ -232,6 +239,9 @@ fn failures(r: &Report) -> Vec<String> {
             )),
         }
     }
+    if let Some(d) = &r.drape {
+        out.extend(drape::failures(d));
+    }
     for h in &r.determinism {
         if !h.agree() {
             out.push(format!(
@@ -268,6 +278,7 @@ mod tests {
             energy: Vec::new(),
             scenes: Vec::new(),
             worlds: Vec::new(),
+            drape: None,
             determinism: Vec::new(),
             speed: machine::Speed {
                 workload: "none".into(),

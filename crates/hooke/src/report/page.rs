@@ -117,6 +117,7 @@ pub(super) fn write(files: &mut Pending, r: &Report) -> Result<()> {
         h,
         "<nav><a href=#convergence>Convergence</a><a href=#physics>Closed forms</a>\
          <a href=#energy>Energy</a><a href=#scenes>Scenes</a><a href=#worlds>Worlds</a>\
+         <a href=#drape>Drape test</a>\
          <a href=#determinism>Determinism and speed</a><a href=report.json>report.json</a></nav>"
     )?;
     convergence(&mut h, r)?;
@@ -124,6 +125,7 @@ pub(super) fn write(files: &mut Pending, r: &Report) -> Result<()> {
     energy(&mut h, files, r)?;
     scenes(&mut h, r)?;
     worlds(&mut h, r)?;
+    drape(&mut h, r)?;
     machine(&mut h, r)?;
     writeln!(h, "<script>{SCRIPT}</script></body></html>")?;
     files.add(PAGE, h);
@@ -285,6 +287,65 @@ fn scenes(h: &mut String, r: &Report) -> Result<()> {
             )?;
         }
     }
+    Ok(())
+}
+
+fn drape(h: &mut String, r: &Report) -> Result<()> {
+    let Some(d) = &r.drape else {
+        return Ok(writeln!(
+            h,
+            "<h2 id=drape>Drape test</h2><p class=muted>Not run with --quick: \
+             `hooke drape PRESET` runs it.</p>"
+        )?);
+    };
+    writeln!(
+        h,
+        "<h2 id=drape>Drape test</h2><p>Cusick's drape meter (BS 5058, docs/materials.md \
+         \"Drape test\"): a 30 cm disc of irregular triangles on an 18 cm pedestal, one \
+         repeat (seed 1) each, run by `hooke drape` with its defaults until settled. \
+         DC = (A<sub>shadow</sub> − A<sub>pedestal</sub>) / (A<sub>specimen</sub> − \
+         A<sub>pedestal</sub>); nodes are the outline's peaks that rise {} mm above their \
+         valleys. The presets must order silk &lt; cotton &lt; wool &lt; denim at least {} \
+         apart, each DC within 0.2–0.98 and 3–14 nodes; across the sweep of B DC must rise \
+         (by 0.3 at least, never falling more than {} from one B to the next).</p>\
+         <div class=grid>",
+        1e3 * crate::drape::Meter::default().prominence,
+        super::drape::APART,
+        super::drape::DIP
+    )?;
+    for p in &d.presets {
+        writeln!(
+            h,
+            "<figure><img src=\"{}\" alt=\"{} from above\" loading=lazy><figcaption>{}: \
+             DC {:.3}, {} nodes, overhang {:.1} bending lengths{}</figcaption></figure>",
+            p.file.as_deref().unwrap_or_default(),
+            p.what,
+            p.what,
+            p.dc,
+            p.nodes,
+            p.overhang,
+            if p.settled { "" } else { " (NOT SETTLED)" }
+        )?;
+    }
+    writeln!(
+        h,
+        "</div><figure><img src=\"{}\" alt=\"DC against overhang\"></figure>\
+         <div class=scroll><table><tr><th>B (µN·m)</th><th>overhang / c</th><th>DC</th>\
+         <th>nodes</th><th>settled</th></tr>",
+        super::drape::SWEEP_FILE
+    )?;
+    for s in &d.sweep {
+        writeln!(
+            h,
+            "<tr><td>{}</td><td>{:.2}</td><td>{:.3}</td><td>{}</td><td>{}</td></tr>",
+            num(s.bending * 1e6),
+            s.overhang,
+            s.dc,
+            s.nodes,
+            verdict(s.settled)
+        )?;
+    }
+    writeln!(h, "</table></div>")?;
     Ok(())
 }
 

@@ -1,6 +1,7 @@
 //! The report's plots, drawn by plotters as SVG files the page shows beside its tables.
 
 use super::convergence::Sweep;
+use super::drape::Reading;
 use super::energy::EnergyRun;
 use crate::Result;
 use plotters::prelude::*;
@@ -271,6 +272,61 @@ pub(crate) fn energy(scene: &str, runs: &[&EnergyRun], own: &str) -> Result<Stri
                 chart.draw_series(dashes).map_err(drawing)?;
             }
         }
+        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        root.present().map_err(drawing)?;
+    }
+    Ok(svg)
+}
+
+/// The drape coefficient against the overhang in bending lengths: the sweep of `B` as a
+/// line with its points, each preset as a labelled point.
+pub(crate) fn drape(sweep: &[Reading], presets: &[Reading]) -> Result<String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(drawing)?;
+        let most = sweep
+            .iter()
+            .chain(presets)
+            .map(|r| r.overhang)
+            .fold(1.0f64, f64::max);
+        let mut chart = builder(
+            &root,
+            "Cusick's drape test, 30 cm on 18 cm: DC against the overhang",
+            60,
+        )
+        .build_cartesian_2d(0.0..(most * 1.1).ceil(), 0.0..1.0)
+        .map_err(drawing)?;
+        chart
+            .configure_mesh()
+            .label_style(("sans-serif", 15))
+            .axis_desc_style(("sans-serif", 16))
+            .x_desc("overhang (R_specimen − R_pedestal) / c, c = (B/ρg)^⅓")
+            .y_desc("drape coefficient")
+            .draw()
+            .map_err(drawing)?;
+        let line: Vec<(f64, f64)> = sweep.iter().map(|r| (r.overhang, r.dc)).collect();
+        let colour = PALETTE[1];
+        chart
+            .draw_series(LineSeries::new(line.clone(), colour.stroke_width(2)))
+            .map_err(drawing)?
+            .label("cotton's density and membrane, B from 0.5 to 200 µN·m")
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(3))
+            });
+        chart
+            .draw_series(line.iter().map(|&p| Circle::new(p, 4, colour.filled())))
+            .map_err(drawing)?;
+        let mark = PALETTE[0];
+        chart
+            .draw_series(presets.iter().map(|r| {
+                EmptyElement::at((r.overhang, r.dc))
+                    + Cross::new((0, 0), 6, mark.stroke_width(2))
+                    + Text::new(r.what.clone(), (8, -14), ("sans-serif", 15))
+            }))
+            .map_err(drawing)?
+            .label("the presets")
+            .legend(move |(x, y)| Cross::new((x + 9, y), 6, mark.stroke_width(2)));
         legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(drawing)?;
     }
