@@ -332,9 +332,20 @@ pub fn drape(args: &DrapeArgs) -> Result<ExitCode> {
                 r.time
             );
         }
+        let mut counts: Vec<usize> = s.nodes.clone();
+        counts.sort_unstable();
+        counts.dedup();
+        let spread: Vec<String> = counts
+            .iter()
+            .map(|c| format!("{c} ×{}", s.nodes.iter().filter(|n| *n == c).count()))
+            .collect();
         println!(
-            "DC {:.3} ± {:.3} (mean ± sd); nodes {:?}; most often {} nodes, DC there {:.3}",
-            s.dc_mean, s.dc_sd, s.nodes, s.mode, s.dc_at_mode
+            "DC {:.3} ± {:.3} (mean ± sd); nodes {}; most often {} nodes, DC there {:.3}",
+            s.dc_mean,
+            s.dc_sd,
+            spread.join(", "),
+            s.mode,
+            s.dc_at_mode
         );
     }
     large_step_note(&meter);
