@@ -154,9 +154,31 @@ fn a_specimen_that_is_not_the_meters_disc_is_refused() {
         ..Meter::default()
     };
     let error = meter.scene(&preset("cotton"), 1).err().unwrap().to_string();
-    let _ = std::fs::remove_dir_all(&dir);
     assert!(
         error.contains("disc-20cm.obj") && error.contains("30 cm across"),
+        "{error}"
+    );
+    // The right disc standing on edge (the x–y plane): as wide and as large, not flat.
+    let standing: String = hooke_scene::example_meshes::drape_disc_obj(0.30, 0.01)
+        .lines()
+        .map(|line| match line.strip_prefix("v ") {
+            Some(xyz) => {
+                let c: Vec<&str> = xyz.split_whitespace().collect();
+                format!("v {} {} {}\n", c[0], c[2], c[1])
+            }
+            None => format!("{line}\n"),
+        })
+        .collect();
+    let on_edge = dir.join("on-edge.obj");
+    std::fs::write(&on_edge, standing).unwrap();
+    let meter = Meter {
+        mesh: Some(on_edge),
+        ..Meter::default()
+    };
+    let error = meter.scene(&preset("cotton"), 1).err().unwrap().to_string();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(
+        error.contains("on-edge.obj") && error.contains("flat disc"),
         "{error}"
     );
 }
