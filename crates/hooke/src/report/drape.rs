@@ -2,7 +2,7 @@
 //! its view from above with its coefficient and nodes; and the coefficient against the
 //! overhang in bending lengths for a sweep of the bending rigidity.
 
-use super::folder::Pending;
+use super::folder::{Pending, drape_file};
 use crate::Result;
 use crate::drape::Meter;
 use hooke_scene::material::{Material, PRESETS};
@@ -46,14 +46,6 @@ pub(crate) struct Drape {
     pub(crate) presets: Vec<Reading>,
     pub(crate) sweep: Vec<Reading>,
 }
-
-/// The top view of preset `name`.
-pub(crate) fn drape_file(name: &str) -> String {
-    format!("drape-{name}.png")
-}
-
-/// The plot of the sweep.
-pub(crate) const SWEEP_FILE: &str = "drape-sweep.svg";
 
 /// The presets in the order their drape coefficients must rise.
 const ORDER: [&str; 4] = ["silk", "cotton", "wool", "denim"];
@@ -123,7 +115,6 @@ pub(crate) fn runs(
         sweep.push(reading(&meter, &format!("B = {} µN·m", b * 1e6), &m)?.0);
         tick();
     }
-    files.add(SWEEP_FILE, super::plots::drape(&sweep, &presets)?);
     Ok(Some(Drape { presets, sweep }))
 }
 

@@ -49,6 +49,14 @@ pub(crate) fn scene_file(name: &str, kind: &str) -> String {
     format!("scene-{name}-{kind}.png")
 }
 
+/// The drape test's view from above of preset `name`.
+pub(crate) fn drape_file(name: &str) -> String {
+    format!("drape-{name}.png")
+}
+
+/// The drape test's plot of DC against the overhang.
+pub(crate) const DRAPE_SWEEP: &str = "drape-sweep.svg";
+
 /// Every name a report of the built-in `scenes` writes into its folder, the marker first.
 fn names(scenes: &[&str]) -> Vec<String> {
     let mut out = vec![
@@ -69,9 +77,9 @@ fn names(scenes: &[&str]) -> Vec<String> {
     out.extend(
         hooke_scene::material::PRESETS
             .iter()
-            .map(|p| super::drape::drape_file(p.name)),
+            .map(|p| drape_file(p.name)),
     );
-    out.push(super::drape::SWEEP_FILE.into());
+    out.push(DRAPE_SWEEP.into());
     out
 }
 

@@ -125,7 +125,7 @@ pub(super) fn write(files: &mut Pending, r: &Report) -> Result<()> {
     energy(&mut h, files, r)?;
     scenes(&mut h, r)?;
     worlds(&mut h, r)?;
-    drape(&mut h, r)?;
+    drape(&mut h, files, r)?;
     machine(&mut h, r)?;
     writeln!(h, "<script>{SCRIPT}</script></body></html>")?;
     files.add(PAGE, h);
@@ -290,7 +290,7 @@ fn scenes(h: &mut String, r: &Report) -> Result<()> {
     Ok(())
 }
 
-fn drape(h: &mut String, r: &Report) -> Result<()> {
+fn drape(h: &mut String, files: &mut Pending, r: &Report) -> Result<()> {
     let Some(d) = &r.drape else {
         return Ok(writeln!(
             h,
@@ -327,12 +327,16 @@ fn drape(h: &mut String, r: &Report) -> Result<()> {
             if p.settled { "" } else { " (NOT SETTLED)" }
         )?;
     }
+    files.add(
+        super::folder::DRAPE_SWEEP,
+        plots::drape(&d.sweep, &d.presets)?,
+    );
     writeln!(
         h,
         "</div><figure><img src=\"{}\" alt=\"DC against overhang\"></figure>\
          <div class=scroll><table><tr><th>B (µN·m)</th><th>overhang / c</th><th>DC</th>\
          <th>nodes</th><th>settled</th></tr>",
-        super::drape::SWEEP_FILE
+        super::folder::DRAPE_SWEEP
     )?;
     for s in &d.sweep {
         writeln!(
