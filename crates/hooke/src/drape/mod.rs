@@ -117,6 +117,7 @@ impl Meter {
     /// as `seed` says (up to 2° about two horizontal axes, any turn about the vertical), 1 cm
     /// above the pedestal.
     pub fn scene(&self, material: &Material, seed: u64) -> Result<Scene> {
+        self.check_specimen()?;
         let scene = self.scene_at(material, seed, self.dt)?;
         if self.dt > 0.0 {
             return Ok(scene);
@@ -133,7 +134,6 @@ impl Meter {
 
     /// [`Meter::scene`] at the step `dt` (0: any, to be estimated).
     fn scene_at(&self, material: &Material, seed: u64, dt: f64) -> Result<Scene> {
-        self.check_specimen()?;
         let dt = if dt > 0.0 { dt } else { 1e-5 };
         let mut state = seed
             .wrapping_mul(0x9E37_79B9_7F4A_7C15)
