@@ -59,10 +59,12 @@ fn declared(code: &str) -> Vec<String> {
     code.lines()
         .filter_map(|l| {
             let l = l.trim();
-            let l = l
-                .strip_prefix("pub(crate) ")
-                .or(l.strip_prefix("pub "))
-                .unwrap_or(l);
+            // Any visibility: `pub`, `pub(crate)`, `pub(super)`, `pub(in path)`.
+            let l = match l.strip_prefix("pub") {
+                Some(rest) if rest.starts_with('(') => rest.split_once(") ").map_or(l, |(_, r)| r),
+                Some(rest) if rest.starts_with(' ') => rest.trim_start(),
+                _ => l,
+            };
             let name = l.strip_prefix("mod ")?.strip_suffix(';')?;
             Some(name.trim().to_string())
         })
@@ -342,6 +344,14 @@ fn the_checker_finds_a_circle_and_resolves_reexports() {
     assert_eq!(
         expand("crate::{a::X, b::{Y, Z as W}}"),
         ["crate::a::X", "crate::b::Y", "crate::b::Z"]
+    );
+    // Modules of every visibility are read (`pub(in path)` ones were once skipped, and
+    // with them the circle between block descent's detection and its pair list).
+    assert_eq!(
+        declared(
+            "mod a;\npub mod b;\npub(crate) mod c;\npub(super) mod d;\npub(in crate::x) mod e;"
+        ),
+        ["a", "b", "c", "d", "e"]
     );
     let core = load(
         "hooke-core",

@@ -17,7 +17,8 @@
 //! a search over every pair would: only the order of the list (the build's, fixed by the
 //! positions then) differs, and no thread count changes it.
 
-use super::detect::{Topology, bin, bounds_of, boxes_within, by_cell, within};
+use super::cells::{bin, bounds_of, boxes_within, by_cell, within};
+use super::topology::Topology;
 use crate::contact::grid::{Cell, Grid};
 use crate::contact::proximity::{point_triangle, segment_segment};
 use crate::particles::Vec3;

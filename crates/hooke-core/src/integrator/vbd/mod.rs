@@ -12,7 +12,7 @@
 //! * After the colours, each free body moves as a whole by the Newton step of its
 //!   translation (the coarse correction), which Gauss–Seidel alone takes hundreds of
 //!   sweeps to make on a stiff sheet.
-//! * Every update is clipped to its particle's ball from the last detection (`detect.rs`),
+//! * Every update is clipped to its particle's ball from the last detection (`detect/`),
 //!   and kept on the free side of the half-space colliders near it (bounding only the
 //!   motion into them, so particles slide along planes).
 //! * An iteration that leaves a hundredth of the particles waiting at their bounds ends
@@ -22,12 +22,14 @@
 //!   `v = (x - x₀) / dt`.
 
 mod candidates;
+mod cells;
 pub(in crate::integrator) mod detect;
 pub(in crate::integrator) mod graph;
 pub(in crate::integrator) mod local;
 pub(in crate::integrator) mod pairs;
 mod planes;
 pub(crate) mod swept;
+mod topology;
 
 use super::{StepReport, StopRule, Workspace};
 use crate::integrator::Sym3;

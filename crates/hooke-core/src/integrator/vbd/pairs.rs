@@ -8,7 +8,7 @@ use crate::particles::Vec3;
 #[derive(Clone, Copy, Debug)]
 pub(in crate::integrator) enum Sides {
     /// Particle `ids[0]` against triangle `ids[1..4]`, which owns the features marked in
-    /// its mask (see `Topology::owns` in `detect.rs`).
+    /// its mask (see `Topology::owns` in `topology.rs`).
     PointTriangle(u8),
     /// Edge `ids[0..2]` against edge `ids[2..4]`.
     EdgeEdge,

@@ -1,7 +1,7 @@
 //! How near the particles and surfaces are to a moving collider, which sets how far block
 //! descent may let the collider jump at once (the swept step, docs/physics.md §4.1).
 
-use super::detect::bounds_of;
+use super::cells::bounds_of;
 use crate::contact::proximity::feature_triangle;
 use crate::model::Model;
 use crate::particles::Particles;

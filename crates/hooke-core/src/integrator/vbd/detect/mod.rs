@@ -17,17 +17,19 @@
 //! bounds by the reach, which is enough for the same argument. The bound holds whatever the
 //! step size: the integrator can fail to converge, never cross.
 
+mod colliders;
+
+pub(in crate::integrator) use colliders::collider_law;
+
 use super::candidates::{Candidates, SKIN, search};
 use super::graph::Graph;
 use super::pairs::{Pair, Sides, stencil_distance};
-use super::planes::{HalfSpaces, Plane, Touches};
+use super::planes::{HalfSpaces, Touches};
+use super::topology::Topology;
 use crate::collider::response::Response;
-use crate::contact::grid::{Cell, Grid};
-use crate::contact::proximity::feature_triangle;
+use crate::contact::grid::Grid;
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
-use rayon::prelude::*;
-use std::ops::Range;
 
 /// Share of a surface-to-surface distance each side may use up: below one half.
 pub(crate) const GAMMA_SURFACE: f64 = 0.4;
@@ -81,94 +83,6 @@ impl Clearance {
     }
 }
 
-/// The surfaces' primitives, fixed for a model.
-#[derive(Clone, Debug, Default)]
-pub(in crate::integrator) struct Topology {
-    built_for: usize,
-    /// Active surfaces' triangles and edges, with their surface's index.
-    pub(in crate::integrator) triangles: Vec<([u32; 3], u16)>,
-    pub(in crate::integrator) edges: Vec<([u32; 2], u16)>,
-    /// Per particle: its active surface, or `u16::MAX`.
-    pub(in crate::integrator) surface: Vec<u16>,
-    /// Whether any surface pair (self or between bodies) can touch.
-    self_pairs: bool,
-    /// The thickness particles outside every active surface keep from velocity-level
-    /// colliders ([`Model::point_thickness`]).
-    point: f64,
-    /// Per triangle: which of its edges (bits 0..3: ab, bc, ca) and corners (bits 3..6)
-    /// it owns, being the first triangle of its surface to have them.
-    owns: Vec<u8>,
-}
-
-impl Topology {
-    /// The thickness particle `i` keeps: its active surface's, zero outside every one.
-    fn margin(&self, model: &Model, i: usize) -> f64 {
-        match self.surface[i] {
-            u16::MAX => 0.0,
-            s => model.surfaces[s as usize].thickness,
-        }
-    }
-
-    /// The thickness particle `i` keeps from the colliders that bound it (velocity-level
-    /// ones): its surface's, or the point thickness outside every active surface.
-    fn contact_margin(&self, model: &Model, i: usize) -> f64 {
-        match self.surface[i] {
-            u16::MAX => self.point,
-            s => model.surfaces[s as usize].thickness,
-        }
-    }
-
-    /// The thickness particle `i` keeps from a collider answering with `response`: its
-    /// surface's from a penalty wall (the course's force field, which it may enter), and
-    /// at least the point thickness from the others.
-    fn keeps(&self, model: &Model, i: usize, response: &Response) -> f64 {
-        match response {
-            Response::Penalty { .. } => self.margin(model, i),
-            _ => self.contact_margin(model, i),
-        }
-    }
-
-    fn new(model: &Model, n: usize) -> Self {
-        let mut t = Self {
-            built_for: n,
-            surface: vec![u16::MAX; n],
-            point: model.point_thickness(),
-            ..Self::default()
-        };
-        let active: Vec<_> = model.active_surfaces().collect();
-        for &(k, s) in &active {
-            for p in s.particles.clone() {
-                t.surface[p] = k as u16;
-            }
-            t.triangles
-                .extend(s.triangles.iter().map(|&tri| (tri, k as u16)));
-            t.edges.extend(s.edges().into_iter().map(|e| (e, k as u16)));
-        }
-        t.self_pairs = active.len() > 1 || active.iter().any(|(_, s)| s.self_collision);
-        let mut edges = std::collections::HashSet::new();
-        let mut corners = vec![false; n];
-        t.owns = t
-            .triangles
-            .iter()
-            .map(|([a, b, c], _)| {
-                let mut mask = 0u8;
-                for (k, (u, v)) in [(a, b), (b, c), (c, a)].into_iter().enumerate() {
-                    if edges.insert((*u.min(v), *u.max(v))) {
-                        mask |= 1 << k;
-                    }
-                }
-                for (k, v) in [a, b, c].into_iter().enumerate() {
-                    if !std::mem::replace(&mut corners[*v as usize], true) {
-                        mask |= 1 << (3 + k);
-                    }
-                }
-                mask
-            })
-            .collect();
-        t
-    }
-}
-
 /// The result of a detection, and its buffers.
 #[derive(Clone, Debug, Default)]
 pub(in crate::integrator) struct Detection {
@@ -218,96 +132,6 @@ pub(in crate::integrator) struct Detection {
     excess: Vec<f64>,
     /// Per particle: its stiffness scale `m/dt² + Σ ks`.
     pub(in crate::integrator) scale: Vec<f64>,
-}
-
-/// `f` over fixed chunks of `0..n` in parallel, results concatenated in chunk order.
-fn chunked<T: Send>(n: usize, f: impl Fn(Range<usize>) -> Vec<T> + Sync + Send) -> Vec<T> {
-    if n <= CHUNK {
-        return f(0..n);
-    }
-    let parts: Vec<Vec<T>> = (0..n.div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|c| f(c * CHUNK..((c + 1) * CHUNK).min(n)))
-        .collect();
-    parts.into_iter().flatten().collect()
-}
-
-/// The box holding `points` (at least one).
-pub(in crate::integrator) fn bounds_of(points: &[&Vec3]) -> (Vec3, Vec3) {
-    let mut lo = *points[0];
-    let mut hi = *points[0];
-    for p in &points[1..] {
-        lo = lo.inf(p);
-        hi = hi.sup(p);
-    }
-    (lo, hi)
-}
-
-/// Whether point `p` lies in box `lo..hi` grown by `r`.
-pub(in crate::integrator) fn within(p: &Vec3, (lo, hi): &(Vec3, Vec3), r: f64) -> bool {
-    (0..3).all(|k| p[k] >= lo[k] - r && p[k] <= hi[k] + r)
-}
-
-/// Whether boxes `a` and `b` come within `r` of each other.
-pub(in crate::integrator) fn boxes_within(a: &(Vec3, Vec3), b: &(Vec3, Vec3), r: f64) -> bool {
-    (0..3).all(|k| a.0[k] <= b.1[k] + r && b.0[k] <= a.1[k] + r)
-}
-
-/// Bins `boxes` into `grid` with cells as large as the largest box plus `reach`, so that
-/// everything within `reach` of a query lies in the 27 cells around it ([`by_cell`]).
-pub(in crate::integrator) fn bin(grid: &mut Grid, boxes: &[(Vec3, Vec3)], reach: f64) {
-    let extent = boxes
-        .iter()
-        .map(|(lo, hi)| (hi - lo).max())
-        .fold(0.0, f64::max);
-    grid.build(extent + reach, boxes.iter().map(|(lo, _)| *lo));
-}
-
-/// Calls `test(q, candidates, out)` for every query `q` whose cell is `cells[q]`, with the
-/// items of the 27 cells around that cell (every item whose low corner lies within one cell
-/// of the query's), gathered once per occupied cell. Results come in the order of (cell,
-/// query): fixed by the positions alone, never by threads.
-pub(in crate::integrator) fn by_cell<T: Send>(
-    grid: &Grid,
-    cells: &[Cell],
-    test: impl Fn(usize, &[u32], &mut Vec<T>) + Sync + Send,
-) -> Vec<T> {
-    let mut order: Vec<u32> = (0..cells.len() as u32).collect();
-    order.sort_unstable_by_key(|&q| (cells[q as usize], q));
-    let mut starts: Vec<usize> = (0..order.len())
-        .filter(|&k| k == 0 || cells[order[k] as usize] != cells[order[k - 1] as usize])
-        .collect();
-    starts.push(order.len());
-    chunked(starts.len() - 1, |groups| {
-        let mut out = Vec::new();
-        let mut candidates = Vec::new();
-        for g in groups {
-            let members = &order[starts[g]..starts[g + 1]];
-            let c = cells[members[0] as usize];
-            candidates.clear();
-            for i in -1..=1 {
-                for j in -1..=1 {
-                    for k in -1..=1 {
-                        grid.visit([c[0] + i, c[1] + j, c[2] + k], |t| candidates.push(t));
-                    }
-                }
-            }
-            for &q in members {
-                test(q as usize, &candidates, &mut out);
-            }
-        }
-        out
-    })
-}
-
-/// The normal stiffness and Coulomb coefficient a collider's response gives a contact with
-/// stiffness scale `scale`.
-pub(in crate::integrator) fn collider_law(response: &Response, scale: f64) -> (f64, f64) {
-    match *response {
-        Response::Penalty { kc, .. } => (kc, 0.0),
-        Response::Restitution { friction, .. } => (CONTACT_STIFFNESS * scale, friction),
-        Response::Stick => (CONTACT_STIFFNESS * scale, f64::INFINITY),
-    }
 }
 
 impl Detection {
@@ -444,155 +268,6 @@ impl Detection {
         self.set_radii(allowed, surface_reach);
     }
 
-    /// Per particle: the nearest collider surface (capped at `reach`) and which colliders
-    /// it may touch before the next detection.
-    fn detect_colliders(&mut self, model: &Model, x: &[Vec3], reach: f64) {
-        let topology = &self.topology;
-        let n = x.len();
-        self.point_collider.resize(n, Clearance::new(reach));
-        self.touches.resize(n, Touches::default());
-        self.halves.resize(n, HalfSpaces::default());
-        let one = |i: usize, (clearance, near, halves): (&mut Clearance, &mut Touches, &mut HalfSpaces)| {
-            let (lo, hi) = (x[i].add_scalar(-reach), x[i].add_scalar(reach));
-            *clearance = Clearance::new(reach);
-            *near = Touches::default();
-            *halves = HalfSpaces::default();
-            for (k, slot) in model.colliders.iter().enumerate() {
-                if !slot.shape.may_touch(&lo, &hi, 0.0) {
-                    continue;
-                }
-                let half = slot.shape.is_half_space();
-                // A penalty collider is a force field the course lets particles enter: it
-                // bounds nothing, and its surface is felt wherever the search reaches.
-                let force = slot.response.is_force();
-                let margin = topology.keeps(model, i, &slot.response);
-                slot.shape.contacts_within(&x[i], reach, &mut |c| {
-                    let d = reach - c.depth;
-                    // Inside already: no bound from it (staying is no crossing); its
-                    // contact pushes the particle out.
-                    let inside = d < 0.0;
-                    let felt = force || inside || d <= FELT * margin;
-                    // A half-space bounds only the motion along its normal.
-                    let kept = half && !force && !inside && halves.keep(c.point, c.normal, d);
-                    if !force && !inside && !kept {
-                        clearance.see(d, felt);
-                    }
-                    if felt {
-                        let plane = Plane {
-                            collider: k as u16,
-                            point: c.point,
-                            normal: c.normal,
-                        };
-                        near.keep(plane, d);
-                    }
-                });
-            }
-        };
-        let (clearances, near, halves) = (
-            &mut self.point_collider,
-            &mut self.touches,
-            &mut self.halves,
-        );
-        if n <= CHUNK {
-            for i in 0..n {
-                one(i, (&mut clearances[i], &mut near[i], &mut halves[i]));
-            }
-        } else {
-            clearances
-                .par_chunks_mut(CHUNK)
-                .zip(near.par_chunks_mut(CHUNK))
-                .zip(halves.par_chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(|(c, ((cl, ne), ha))| {
-                    for k in 0..cl.len() {
-                        one(c * CHUNK + k, (&mut cl[k], &mut ne[k], &mut ha[k]));
-                    }
-                });
-        }
-    }
-
-    /// Per surface triangle: the nearest sharp collider feature (capped at `reach`), and the
-    /// feature pairs it may touch before the next detection, with how far each feature
-    /// point moves in the step of length `dt`.
-    fn detect_features(&mut self, model: &Model, x: &[Vec3], reach: f64, dt: f64) {
-        let triangles = &self.topology.triangles;
-        self.triangle_collider.clear();
-        self.triangle_collider
-            .resize(triangles.len(), Clearance::new(reach));
-        self.pairs.clear();
-        if !model.colliders.iter().any(|c| c.shape.has_features()) {
-            return;
-        }
-        let scale = &self.scale;
-        let (points, touches) = (&self.point_collider, &self.touches);
-        let found = chunked(triangles.len(), |range| {
-            let mut out = Vec::new();
-            for t in range {
-                let (tri, s) = triangles[t];
-                let [a, b, c] = tri.map(|i| &x[i as usize]);
-                let (lo, hi) = bounds_of(&[a, b, c]);
-                let h = model.surfaces[s as usize].thickness;
-                let mut clearance = Clearance::new(reach);
-                // A feature is a point of a collider's surface, so it is at least as far
-                // from a corner as the nearest surface point is, and at least that less the
-                // triangle's size from the triangle: a triangle whose corners all see no
-                // surface within the reach plus its size has no feature within the reach
-                // (unless a corner is inside something, which its contacts then say).
-                let nearest = tri
-                    .iter()
-                    .map(|&i| points[i as usize].nearest)
-                    .fold(0.0, f64::max);
-                let size = (a - b).norm().max((b - c).norm()).max((c - a).norm());
-                let felt = tri.iter().any(|&i| touches[i as usize].count != 0);
-                if !felt && nearest - size >= reach {
-                    out.push((t, clearance, Vec::new()));
-                    continue;
-                }
-                let mut pairs = Vec::new();
-                for slot in model.colliders.iter().filter(|c| c.shape.has_features()) {
-                    let (k, mu) = collider_law(
-                        &slot.response,
-                        tri.iter().map(|&i| scale[i as usize]).fold(0.0, f64::max),
-                    );
-                    slot.shape
-                        .features(&lo.add_scalar(-reach), &hi.add_scalar(reach), &mut |f| {
-                            // The boxes' distance bounds the feature's from below: a feature
-                            // no nearer than what is already known, and not felt, changes
-                            // nothing.
-                            let (flo, fhi) = f.bounds();
-                            let apart = (0..3)
-                                .map(|k| (flo[k] - hi[k]).max(lo[k] - fhi[k]).max(0.0).powi(2))
-                                .sum::<f64>()
-                                .sqrt();
-                            if apart >= clearance.nearest && apart > FELT * h {
-                                return;
-                            }
-                            let (anchor, w) = feature_triangle(&f, a, b, c);
-                            let d = (a * w[0] + b * w[1] + c * w[2] - anchor).norm();
-                            clearance.see(d, d <= FELT * h);
-                            if d <= FELT * h {
-                                let carry = slot.shape.velocity(&anchor) * dt;
-                                pairs.push(Pair {
-                                    sides: Sides::Feature(anchor, carry),
-                                    ids: [tri[0], tri[1], tri[2], u32::MAX],
-                                    h,
-                                    k,
-                                    mu,
-                                });
-                            }
-                        });
-                }
-                out.push((t, clearance, pairs));
-            }
-            out
-        });
-        for (t, d, pairs) in found {
-            self.triangle_collider[t] = d;
-            self.pairs.extend(pairs);
-        }
-    }
-
-    /// Point–triangle and edge–edge distances between surfaces (capped at `reach`), and the
     /// pairs within reach.
     fn detect_surfaces(&mut self, model: &Model, x: &[Vec3], reach: f64) {
         let n = x.len();

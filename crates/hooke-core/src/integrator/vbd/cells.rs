@@ -1,0 +1,95 @@
+//! Searching by cells: primitives binned by their boxes into a uniform grid, each query
+//! tested against the 27 cells around its own, in parallel over fixed chunks so that the
+//! results' order is fixed by the positions alone (the detection's and the pair list's
+//! searches, `detect/` and `candidates.rs`).
+
+use crate::contact::grid::{Cell, Grid};
+use crate::particles::Vec3;
+use rayon::prelude::*;
+use std::ops::Range;
+
+/// Queries (or primitives) per parallel chunk.
+const CHUNK: usize = 512;
+
+/// `f` over fixed chunks of `0..n` in parallel, results concatenated in chunk order.
+pub(in crate::integrator) fn chunked<T: Send>(
+    n: usize,
+    f: impl Fn(Range<usize>) -> Vec<T> + Sync + Send,
+) -> Vec<T> {
+    if n <= CHUNK {
+        return f(0..n);
+    }
+    let parts: Vec<Vec<T>> = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| f(c * CHUNK..((c + 1) * CHUNK).min(n)))
+        .collect();
+    parts.into_iter().flatten().collect()
+}
+
+/// The box holding `points` (at least one).
+pub(in crate::integrator) fn bounds_of(points: &[&Vec3]) -> (Vec3, Vec3) {
+    let mut lo = *points[0];
+    let mut hi = *points[0];
+    for p in &points[1..] {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    (lo, hi)
+}
+
+/// Whether point `p` lies in box `lo..hi` grown by `r`.
+pub(in crate::integrator) fn within(p: &Vec3, (lo, hi): &(Vec3, Vec3), r: f64) -> bool {
+    (0..3).all(|k| p[k] >= lo[k] - r && p[k] <= hi[k] + r)
+}
+
+/// Whether boxes `a` and `b` come within `r` of each other.
+pub(in crate::integrator) fn boxes_within(a: &(Vec3, Vec3), b: &(Vec3, Vec3), r: f64) -> bool {
+    (0..3).all(|k| a.0[k] <= b.1[k] + r && b.0[k] <= a.1[k] + r)
+}
+
+/// Bins `boxes` into `grid` with cells as large as the largest box plus `reach`, so that
+/// everything within `reach` of a query lies in the 27 cells around it ([`by_cell`]).
+pub(in crate::integrator) fn bin(grid: &mut Grid, boxes: &[(Vec3, Vec3)], reach: f64) {
+    let extent = boxes
+        .iter()
+        .map(|(lo, hi)| (hi - lo).max())
+        .fold(0.0, f64::max);
+    grid.build(extent + reach, boxes.iter().map(|(lo, _)| *lo));
+}
+
+/// Calls `test(q, candidates, out)` for every query `q` whose cell is `cells[q]`, with the
+/// items of the 27 cells around that cell (every item whose low corner lies within one cell
+/// of the query's), gathered once per occupied cell. Results come in the order of (cell,
+/// query): fixed by the positions alone, never by threads.
+pub(in crate::integrator) fn by_cell<T: Send>(
+    grid: &Grid,
+    cells: &[Cell],
+    test: impl Fn(usize, &[u32], &mut Vec<T>) + Sync + Send,
+) -> Vec<T> {
+    let mut order: Vec<u32> = (0..cells.len() as u32).collect();
+    order.sort_unstable_by_key(|&q| (cells[q as usize], q));
+    let mut starts: Vec<usize> = (0..order.len())
+        .filter(|&k| k == 0 || cells[order[k] as usize] != cells[order[k - 1] as usize])
+        .collect();
+    starts.push(order.len());
+    chunked(starts.len() - 1, |groups| {
+        let mut out = Vec::new();
+        let mut candidates = Vec::new();
+        for g in groups {
+            let members = &order[starts[g]..starts[g + 1]];
+            let c = cells[members[0] as usize];
+            candidates.clear();
+            for i in -1..=1 {
+                for j in -1..=1 {
+                    for k in -1..=1 {
+                        grid.visit([c[0] + i, c[1] + j, c[2] + k], |t| candidates.push(t));
+                    }
+                }
+            }
+            for &q in members {
+                test(q as usize, &candidates, &mut out);
+            }
+        }
+        out
+    })
+}
