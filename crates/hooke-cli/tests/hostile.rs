@@ -397,6 +397,28 @@ fn a_block_descent_bench_splits_its_time_into_parts_that_sum_to_the_whole() {
         (parts - seconds).abs() <= 1e-9 * seconds,
         "{parts} vs {seconds}"
     );
+    // The per-sweep and per-detection figures are the split's parts over the counts.
+    let steps = figures["steps"].as_f64().unwrap();
+    let free = figures["free_particles"].as_f64().unwrap();
+    let iterations = figures["vbd_iterations_per_step"].as_f64().unwrap() * steps;
+    let detections = figures["vbd_detections_per_step"].as_f64().unwrap() * steps;
+    let sweep = split["sweep_ns_per_particle"].as_f64().unwrap();
+    let detection = split["detection_ms"].as_f64().unwrap();
+    let near = |a: f64, b: f64| (a - b).abs() <= 1e-6 * b.abs().max(1e-12);
+    assert!(
+        near(
+            sweep,
+            1e9 * split["sweeps"].as_f64().unwrap() / (iterations * free)
+        ),
+        "{split}"
+    );
+    assert!(
+        near(
+            detection,
+            1e3 * split["detection"].as_f64().unwrap() / detections
+        ),
+        "{split}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
