@@ -17,7 +17,7 @@
 //! a search over every pair would: only the order of the list (the build's, fixed by the
 //! positions then) differs, and no thread count changes it.
 
-use super::cells::{bin, bounds_of, boxes_within, by_cell, within};
+use super::cells::{bin, bounds_of, boxes_within, by_cell, concatenate, within};
 use super::topology::Topology;
 use crate::contact::grid::{Cell, Grid};
 use crate::contact::proximity::{point_triangle, segment_segment};
@@ -102,6 +102,13 @@ impl Candidates {
     /// Whether the list may miss a pair within `reach` (see the module docs).
     pub(in crate::integrator) fn stale(&self, reach: f64) -> bool {
         !self.valid || 2.0 * self.most >= self.built - reach
+    }
+
+    /// Frees the list (the pairs, not the travel): a build follows.
+    pub(in crate::integrator) fn forget(&mut self) {
+        self.valid = false;
+        self.point_tri = Vec::new();
+        self.edge_edge = Vec::new();
     }
 
     /// Keeps `point_tri` and `edge_edge`, measured now, as every pair within `built`.
@@ -192,8 +199,7 @@ fn check(
     if list.len() <= CHUNK {
         return run(list);
     }
-    let parts: Vec<Vec<(u32, u32, f64)>> = list.par_chunks_mut(CHUNK).map(run).collect();
-    parts.into_iter().flatten().collect()
+    concatenate(list.par_chunks_mut(CHUNK).map(run).collect())
 }
 
 /// Every point–triangle pair (a surface particle, a triangle not holding it) and edge–edge

@@ -21,9 +21,25 @@ pub(in crate::integrator) fn chunked<T: Send>(
     }
     let parts: Vec<Vec<T>> = (0..n.div_ceil(CHUNK))
         .into_par_iter()
-        .map(|c| f(c * CHUNK..((c + 1) * CHUNK).min(n)))
+        .map(|c| {
+            let mut part = f(c * CHUNK..((c + 1) * CHUNK).min(n));
+            // Without its growth's slack: the parts and their concatenation are the
+            // detection's peak memory.
+            part.shrink_to_fit();
+            part
+        })
         .collect();
-    parts.into_iter().flatten().collect()
+    concatenate(parts)
+}
+
+/// `parts` end to end, in one allocation of exactly their length (a flattening collect
+/// grows by doubling: up to twice the list, beside the parts, at the list's build).
+pub(in crate::integrator) fn concatenate<T>(parts: Vec<Vec<T>>) -> Vec<T> {
+    let mut out = Vec::with_capacity(parts.iter().map(Vec::len).sum());
+    for part in parts {
+        out.extend(part);
+    }
+    out
 }
 
 /// The box holding `points` (at least one).

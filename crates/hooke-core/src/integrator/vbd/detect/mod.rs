@@ -301,6 +301,9 @@ impl Detection {
         let rest = &self.rest;
         self.candidates.update(topo, x, reach);
         if self.candidates.stale(reach) {
+            // The old list goes before the new one is searched: the two at once were the
+            // block-descent step's peak memory.
+            self.candidates.forget();
             let built = reach + SKIN * reach;
             let (point_tri, edge_edge) = search(
                 topo,
