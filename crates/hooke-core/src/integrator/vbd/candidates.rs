@@ -219,29 +219,35 @@ pub(in crate::integrator) fn search(
     bin(triangle_grid, &tri_boxes, reach);
     let grid = &*triangle_grid;
     let at: Vec<Cell> = x.iter().map(|p| grid.cell_of(p)).collect();
-    let point_tri = by_cell(grid, &at, |v, candidates, out| {
-        if topo.surface[v] == u16::MAX {
-            return;
-        }
-        let p = &x[v];
-        for &t in candidates {
-            let (tri, _) = topo.triangles[t as usize];
-            if tri.contains(&(v as u32)) || !within(p, &tri_boxes[t as usize], reach) {
-                continue;
+    let point = |v: usize| (x[v], x[v]);
+    let point_tri = by_cell(
+        grid,
+        &at,
+        (&point, &tri_boxes, reach),
+        |v, candidates, out| {
+            if topo.surface[v] == u16::MAX {
+                return;
             }
-            let [a, b, c] = tri.map(|i| &x[i as usize]);
-            let w = point_triangle(p, a, b, c);
-            let d = (p - (a * w[0] + b * w[1] + c * w[2])).norm();
-            if d < reach {
-                out.push(Candidate {
-                    a: v as u32,
-                    b: t,
-                    distance: d,
-                    travel: 0.0,
-                });
+            let p = &x[v];
+            for &t in candidates {
+                let (tri, _) = topo.triangles[t as usize];
+                if tri.contains(&(v as u32)) || !within(p, &tri_boxes[t as usize], reach) {
+                    continue;
+                }
+                let [a, b, c] = tri.map(|i| &x[i as usize]);
+                let w = point_triangle(p, a, b, c);
+                let d = (p - (a * w[0] + b * w[1] + c * w[2])).norm();
+                if d < reach {
+                    out.push(Candidate {
+                        a: v as u32,
+                        b: t,
+                        distance: d,
+                        travel: 0.0,
+                    });
+                }
             }
-        }
-    });
+        },
+    );
     let edge_boxes: Vec<(Vec3, Vec3)> = topo
         .edges
         .iter()
@@ -255,38 +261,44 @@ pub(in crate::integrator) fn search(
     bin(edge_grid, &edge_boxes, reach);
     let grid = &*edge_grid;
     let at: Vec<Cell> = edge_boxes.iter().map(|(lo, _)| grid.cell_of(lo)).collect();
-    let edge_edge = by_cell(grid, &at, |e, candidates, out| {
-        let ([a, b], _) = topo.edges[e];
-        let bx = &edge_boxes[e];
-        for &f in candidates {
-            let f = f as usize;
-            if f >= e {
-                continue;
+    let edge = |e: usize| edge_boxes[e];
+    let edge_edge = by_cell(
+        grid,
+        &at,
+        (&edge, &edge_boxes, reach),
+        |e, candidates, out| {
+            let ([a, b], _) = topo.edges[e];
+            let bx = &edge_boxes[e];
+            for &f in candidates {
+                let f = f as usize;
+                if f >= e {
+                    continue;
+                }
+                let ([c0, d0], _) = topo.edges[f];
+                if [c0, d0].contains(&a) || [c0, d0].contains(&b) {
+                    continue;
+                }
+                if !boxes_within(bx, &edge_boxes[f], reach) {
+                    continue;
+                }
+                let (p1, q1, p2, q2) = (
+                    &x[a as usize],
+                    &x[b as usize],
+                    &x[c0 as usize],
+                    &x[d0 as usize],
+                );
+                let (s, t) = segment_segment(p1, q1, p2, q2);
+                let d = ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm();
+                if d < reach {
+                    out.push(Candidate {
+                        a: e as u32,
+                        b: f as u32,
+                        distance: d,
+                        travel: 0.0,
+                    });
+                }
             }
-            let ([c0, d0], _) = topo.edges[f];
-            if [c0, d0].contains(&a) || [c0, d0].contains(&b) {
-                continue;
-            }
-            if !boxes_within(bx, &edge_boxes[f], reach) {
-                continue;
-            }
-            let (p1, q1, p2, q2) = (
-                &x[a as usize],
-                &x[b as usize],
-                &x[c0 as usize],
-                &x[d0 as usize],
-            );
-            let (s, t) = segment_segment(p1, q1, p2, q2);
-            let d = ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm();
-            if d < reach {
-                out.push(Candidate {
-                    a: e as u32,
-                    b: f as u32,
-                    distance: d,
-                    travel: 0.0,
-                });
-            }
-        }
-    });
+        },
+    );
     (point_tri, edge_edge)
 }

@@ -8,6 +8,12 @@ use crate::particles::Vec3;
 use rayon::prelude::*;
 use std::ops::Range;
 
+/// A box as its low and high corners.
+pub(in crate::integrator) type Aabb = (Vec3, Vec3);
+
+/// A query's box by its index.
+pub(in crate::integrator) type QueryBox<'a> = dyn Fn(usize) -> Aabb + Sync + 'a;
+
 /// Queries (or primitives) per parallel chunk.
 const CHUNK: usize = 512;
 
@@ -77,11 +83,19 @@ pub(in crate::integrator) fn bin(grid: &mut Grid, boxes: &[(Vec3, Vec3)], reach:
 /// items of the 27 cells around that cell (every item whose low corner lies within one cell
 /// of the query's), gathered once per occupied cell. Results come in the order of (cell,
 /// query): fixed by the positions alone, never by threads.
+///
+/// `boxes` (each query's box, each item's box, the reach) prunes a cell's items to those
+/// whose box comes within the reach of its queries' joint box (by a nanometre more, so
+/// that rounding never drops one a query's own box test would keep): the same items reach
+/// `test`, in the same order, fewer of those that none of the cell's queries can meet.
 pub(in crate::integrator) fn by_cell<T: Send>(
     grid: &Grid,
     cells: &[Cell],
+    boxes: (&QueryBox<'_>, &[Aabb], f64),
     test: impl Fn(usize, &[u32], &mut Vec<T>) + Sync + Send,
 ) -> Vec<T> {
+    let (query_box, item_boxes, reach) = boxes;
+    let pad = reach + 1e-9;
     let mut order: Vec<u32> = (0..cells.len() as u32).collect();
     order.sort_unstable_by_key(|&q| (cells[q as usize], q));
     let mut starts: Vec<usize> = (0..order.len())
@@ -95,10 +109,19 @@ pub(in crate::integrator) fn by_cell<T: Send>(
             let members = &order[starts[g]..starts[g + 1]];
             let c = cells[members[0] as usize];
             candidates.clear();
+            let mut joint = query_box(members[0] as usize);
+            for &q in &members[1..] {
+                let (lo, hi) = query_box(q as usize);
+                joint = (joint.0.inf(&lo), joint.1.sup(&hi));
+            }
             for i in -1..=1 {
                 for j in -1..=1 {
                     for k in -1..=1 {
-                        grid.visit([c[0] + i, c[1] + j, c[2] + k], |t| candidates.push(t));
+                        grid.visit([c[0] + i, c[1] + j, c[2] + k], |t| {
+                            if boxes_within(&joint, &item_boxes[t as usize], pad) {
+                                candidates.push(t);
+                            }
+                        });
                     }
                 }
             }
