@@ -302,3 +302,117 @@ pub(in crate::integrator) fn search(
     );
     (point_tri, edge_edge)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Model;
+    use crate::model::surface::Surface;
+
+    /// A 14×14 sheet folded over itself, each point nudged by a fixed pseudo-random amount:
+    /// pairs at every distance, above and beside each other.
+    fn folded_sheet() -> (Model, Vec<Vec3>) {
+        let (n, s) = (14usize, 0.01);
+        let mut state = 12345u64;
+        let mut jitter = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.4 * s
+        };
+        let mut x = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                // The far half turned back over the near half, 0.6 spacings above it.
+                let (z, y) = if j < n / 2 {
+                    (j as f64 * s, 0.0)
+                } else {
+                    ((n - 1 - j) as f64 * s, 0.6 * s)
+                };
+                x.push(Vec3::new(
+                    i as f64 * s + jitter(),
+                    y + jitter(),
+                    z + jitter(),
+                ));
+            }
+        }
+        let mut triangles = Vec::new();
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let a = (j * n + i) as u32;
+                let (b, c, d) = (a + 1, a + n as u32, a + n as u32 + 1);
+                triangles.push([a, b, d]);
+                triangles.push([a, d, c]);
+            }
+        }
+        let model = Model {
+            surfaces: vec![Surface {
+                particles: 0..n * n,
+                triangles,
+                thickness: 0.002,
+                self_collision: true,
+                friction: 0.0,
+            }],
+            ..Model::default()
+        };
+        (model, x)
+    }
+
+    /// The search finds every point–triangle and edge–edge pair within the reach, with the
+    /// distance measuring it alone gives, and nothing else: what the list's budgets and
+    /// each cell's pruning rest on.
+    #[test]
+    fn the_search_finds_exactly_the_pairs_a_test_of_every_pair_finds() {
+        let (model, x) = folded_sheet();
+        let topo = Topology::new(&model, x.len());
+        let reach = 0.013;
+        let (point_tri, edge_edge) = search(
+            &topo,
+            &x,
+            reach,
+            (&mut Grid::default(), &mut Grid::default()),
+        );
+        let mut want_points = Vec::new();
+        for v in 0..x.len() {
+            for (t, (tri, _)) in topo.triangles.iter().enumerate() {
+                if tri.contains(&(v as u32)) {
+                    continue;
+                }
+                let [a, b, c] = tri.map(|i| &x[i as usize]);
+                let w = point_triangle(&x[v], a, b, c);
+                let d = (x[v] - (a * w[0] + b * w[1] + c * w[2])).norm();
+                if d < reach {
+                    want_points.push((v as u32, t as u32, d.to_bits()));
+                }
+            }
+        }
+        let mut want_edges = Vec::new();
+        for (e, ([a, b], _)) in topo.edges.iter().enumerate() {
+            for (f, ([c, d], _)) in topo.edges.iter().enumerate().take(e) {
+                if [c, d].contains(&a) || [c, d].contains(&b) {
+                    continue;
+                }
+                let [p1, q1, p2, q2] = [a, b, c, d].map(|&i| &x[i as usize]);
+                let (s, t) = segment_segment(p1, q1, p2, q2);
+                let dist = ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm();
+                if dist < reach {
+                    want_edges.push((e as u32, f as u32, dist.to_bits()));
+                }
+            }
+        }
+        let found = |list: &[Candidate]| {
+            let mut v: Vec<_> = list
+                .iter()
+                .map(|c| (c.a, c.b, c.distance.to_bits()))
+                .collect();
+            v.sort_unstable();
+            v
+        };
+        want_points.sort_unstable();
+        want_edges.sort_unstable();
+        // The fold puts pairs across the layers within the reach, not only neighbours.
+        assert!(want_points.len() > 1000 && want_edges.len() > 1000);
+        assert_eq!(found(&point_tri), want_points);
+        assert_eq!(found(&edge_edge), want_edges);
+    }
+}
