@@ -58,6 +58,18 @@ pub(in crate::integrator) struct Candidates {
     edge_edge: Vec<Candidate>,
 }
 
+/// The distance from `p` to triangle `abc`.
+fn point_triangle_distance(p: &Vec3, [a, b, c]: [&Vec3; 3]) -> f64 {
+    let w = point_triangle(p, a, b, c);
+    (p - (a * w[0] + b * w[1] + c * w[2])).norm()
+}
+
+/// The distance between segments `p1q1` and `p2q2`.
+fn segment_distance([p1, q1, p2, q2]: [&Vec3; 4]) -> f64 {
+    let (s, t) = segment_segment(p1, q1, p2, q2);
+    ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm()
+}
+
 /// The mean of the surface particles' positions (zero without any).
 fn surface_mean(topo: &Topology, x: &[Vec3]) -> Vec3 {
     let (mut sum, mut count) = (Vec3::zeros(), 0usize);
@@ -147,10 +159,7 @@ impl Candidates {
             },
             |c| {
                 let (tri, _) = topo.triangles[c.b as usize];
-                let [a, b, cc] = tri.map(|i| &x[i as usize]);
-                let p = &x[c.a as usize];
-                let w = point_triangle(p, a, b, cc);
-                (p - (a * w[0] + b * w[1] + cc * w[2])).norm()
+                point_triangle_distance(&x[c.a as usize], tri.map(|i| &x[i as usize]))
             },
         );
         let ends = |c: &Candidate| {
@@ -162,11 +171,7 @@ impl Candidates {
             &mut self.edge_edge,
             reach,
             |c| ends(c).iter().map(|&i| travel[i as usize]).sum::<f64>(),
-            |c| {
-                let [p1, q1, p2, q2] = ends(c).map(|i| &x[i as usize]);
-                let (s, u) = segment_segment(p1, q1, p2, q2);
-                ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * u)).norm()
-            },
+            |c| segment_distance(ends(c).map(|i| &x[i as usize])),
         );
         (points, edges)
     }
@@ -234,9 +239,7 @@ pub(in crate::integrator) fn search(
                 if tri.contains(&(v as u32)) || !within(p, &tri_boxes[t as usize], reach) {
                     continue;
                 }
-                let [a, b, c] = tri.map(|i| &x[i as usize]);
-                let w = point_triangle(p, a, b, c);
-                let d = (p - (a * w[0] + b * w[1] + c * w[2])).norm();
+                let d = point_triangle_distance(p, tri.map(|i| &x[i as usize]));
                 if d < reach {
                     out.push(Candidate {
                         a: v as u32,
@@ -281,14 +284,7 @@ pub(in crate::integrator) fn search(
                 if !boxes_within(bx, &edge_boxes[f], reach) {
                     continue;
                 }
-                let (p1, q1, p2, q2) = (
-                    &x[a as usize],
-                    &x[b as usize],
-                    &x[c0 as usize],
-                    &x[d0 as usize],
-                );
-                let (s, t) = segment_segment(p1, q1, p2, q2);
-                let d = ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm();
+                let d = segment_distance([a, b, c0, d0].map(|i| &x[i as usize]));
                 if d < reach {
                     out.push(Candidate {
                         a: e as u32,
@@ -378,9 +374,7 @@ mod tests {
                 if tri.contains(&(v as u32)) {
                     continue;
                 }
-                let [a, b, c] = tri.map(|i| &x[i as usize]);
-                let w = point_triangle(&x[v], a, b, c);
-                let d = (x[v] - (a * w[0] + b * w[1] + c * w[2])).norm();
+                let d = point_triangle_distance(&x[v], tri.map(|i| &x[i as usize]));
                 if d < reach {
                     want_points.push((v as u32, t as u32, d.to_bits()));
                 }
@@ -392,9 +386,7 @@ mod tests {
                 if [c, d].contains(&a) || [c, d].contains(&b) {
                     continue;
                 }
-                let [p1, q1, p2, q2] = [a, b, c, d].map(|&i| &x[i as usize]);
-                let (s, t) = segment_segment(p1, q1, p2, q2);
-                let dist = ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm();
+                let dist = segment_distance([a, b, c, d].map(|&i| &x[i as usize]));
                 if dist < reach {
                     want_edges.push((e as u32, f as u32, dist.to_bits()));
                 }

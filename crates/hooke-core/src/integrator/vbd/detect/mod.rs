@@ -83,6 +83,21 @@ impl Clearance {
     }
 }
 
+/// Into `out`, each particle's clearance (`particles`) met with its triangles'.
+fn per_particle(
+    topo: &Topology,
+    (particles, triangles): (&[Clearance], &[Clearance]),
+    out: &mut Vec<Clearance>,
+) {
+    out.clear();
+    out.extend_from_slice(particles);
+    for (t, (tri, _)) in topo.triangles.iter().enumerate() {
+        for &i in tri {
+            out[i as usize].meet(&triangles[t]);
+        }
+    }
+}
+
 /// The result of a detection, and its buffers.
 #[derive(Clone, Debug, Default)]
 pub(in crate::integrator) struct Detection {
@@ -415,13 +430,11 @@ impl Detection {
     fn collider_allowance(&mut self, model: &Model) -> Vec<f64> {
         let topo = &self.topology;
         let mut collider = std::mem::take(&mut self.scratch_collider);
-        collider.clear();
-        collider.extend_from_slice(&self.point_collider);
-        for (t, (tri, _)) in topo.triangles.iter().enumerate() {
-            for &i in tri {
-                collider[i as usize].meet(&self.triangle_collider[t]);
-            }
-        }
+        per_particle(
+            topo,
+            (&self.point_collider, &self.triangle_collider),
+            &mut collider,
+        );
         let mut allowed = std::mem::take(&mut self.scratch_allowed);
         allowed.clear();
         allowed.extend(
@@ -505,13 +518,11 @@ impl Detection {
         let n = allowed.len();
         let topo = &self.topology;
         let mut own = std::mem::take(&mut self.scratch_own);
-        own.clear();
-        own.extend_from_slice(&self.point_surface);
-        for (t, (tri, _)) in topo.triangles.iter().enumerate() {
-            for &i in tri {
-                own[i as usize].meet(&self.triangle_surface[t]);
-            }
-        }
+        per_particle(
+            topo,
+            (&self.point_surface, &self.triangle_surface),
+            &mut own,
+        );
         for (e, (edge, _)) in topo.edges.iter().enumerate() {
             for &i in edge {
                 own[i as usize].meet(&self.edge_surface[e]);
