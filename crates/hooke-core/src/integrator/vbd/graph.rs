@@ -26,6 +26,9 @@ pub(in crate::integrator) struct Graph {
     pub(in crate::integrator) colours: Vec<Vec<u32>>,
     /// Per particle: `m / dt²`-free stiffness scale, the sum of its springs' `ks`.
     pub(in crate::integrator) stiffness: Vec<f64>,
+    /// Which colouring `colours` is: a number no other colouring in this process had, so
+    /// that what is laid out for one (`lanes/`) knows when it is stale.
+    pub(in crate::integrator) colouring: u64,
     /// Whether the colouring also separates the last detection's contact pairs.
     pub(in crate::integrator) coloured_with_contacts: bool,
     /// The bodies that may translate as a whole: the particles of each connected set of
@@ -82,6 +85,7 @@ impl Graph {
             start,
             neighbours,
             colours: Vec::new(),
+            colouring: 0,
             stiffness,
             coloured_with_contacts: false,
             free_bodies: Vec::new(),
@@ -139,6 +143,8 @@ impl Graph {
             self.colours[c].push(i as u32);
         }
         self.colours.truncate(used);
+        static COLOURINGS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+        self.colouring = COLOURINGS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     }
 
     /// Where particle `i`'s springs start in the list of every particle's springs.

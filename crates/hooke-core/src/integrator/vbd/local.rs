@@ -67,37 +67,34 @@ pub(in crate::integrator) struct Local<'a> {
     pub(in crate::integrator) dt: f64,
 }
 
-/// A gradient and Hessian being summed: `f` is minus the gradient (a force), and the
-/// contacts' gaps as `(d, g)`: the step `s` changes gap `d` by about `g · s`.
-struct Block {
-    f: Vec3,
-    h: Sym3,
-    gaps: Gaps,
+/// A gradient and Hessian being summed: `f` is minus the gradient (a force).
+#[derive(Clone, Copy, Debug, Default)]
+pub(in crate::integrator) struct Block {
+    pub(in crate::integrator) f: Vec3,
+    pub(in crate::integrator) h: Sym3,
 }
 
-/// Gaps kept inline: a particle rarely has more than a few contacts, and a heap
-/// allocation per particle and iteration would cost more than its solve.
-const INLINE_GAPS: usize = 16;
-
-#[derive(Default)]
-struct Gaps {
-    count: usize,
-    inline: [(f64, Vec3); INLINE_GAPS],
-    more: Vec<(f64, Vec3)>,
+/// Where a sum puts its contacts' gaps as `(d, g)`: the step `s` changes gap `d` by about
+/// `g · s`. The update bounds each gap's closing; the other sums need none, and take `()`.
+trait GapSink {
+    fn push(&mut self, gap: (f64, Vec3));
 }
 
-impl Gaps {
+impl GapSink for () {
+    #[inline]
+    fn push(&mut self, _: (f64, Vec3)) {}
+}
+
+/// An update's contact gaps, kept by the caller between particles: a particle rarely has
+/// more than a few contacts, and clearing a list costs nothing where a fresh one per
+/// particle and iteration cost a twentieth of the sweep (it was zeroed and copied).
+#[derive(Debug, Default)]
+pub(in crate::integrator) struct Gaps(Vec<(f64, Vec3)>);
+
+impl GapSink for Gaps {
+    #[inline]
     fn push(&mut self, gap: (f64, Vec3)) {
-        if self.count < INLINE_GAPS {
-            self.inline[self.count] = gap;
-            self.count += 1;
-        } else {
-            self.more.push(gap);
-        }
-    }
-
-    fn iter(&self) -> impl Iterator<Item = &(f64, Vec3)> {
-        self.inline[..self.count].iter().chain(&self.more)
+        self.0.push(gap);
     }
 }
 
@@ -115,11 +112,12 @@ impl Block {
         slip: Vec3,
         w: f64,
         dt: f64,
+        gaps: &mut impl GapSink,
     ) {
         let nn = Sym3::outer(&n);
         self.h = self.h.plus(&nn.scale(k * w * w));
         if let Some(d) = gap {
-            self.gaps.push((d, n * w));
+            gaps.push((d, n * w));
         }
         if lambda <= 0.0 {
             // In the band: stiffness only.
@@ -193,9 +191,18 @@ fn normal_law(d: f64, h: f64, k: f64, n: Vec3) -> (Vec3, f64, f64) {
 }
 
 impl Local<'_> {
-    /// Particle `i`'s position after one Newton step on its local energy, at positions `x`.
-    pub(in crate::integrator) fn solve(&self, i: usize, x: &[Vec3]) -> Vec3 {
-        let b = self.block(i, x);
+    /// Particle `i`'s position after one Newton step on its local energy at positions `x`,
+    /// given its block's inertia, drag and springs (the sweep sums those eight particles at
+    /// a time, `lanes/`); `gaps` is the caller's buffer, cleared here.
+    pub(in crate::integrator) fn update(
+        &self,
+        i: usize,
+        x: &[Vec3],
+        mut b: Block,
+        gaps: &mut Gaps,
+    ) -> Vec3 {
+        gaps.0.clear();
+        self.others(i, x, &mut b, gaps);
         let xi = x[i];
         let inertia = self.mass[i] / (self.dt * self.dt);
         let step =
@@ -206,8 +213,8 @@ impl Local<'_> {
         // No contact gap closes by more than half in one update: a Newton step on the
         // barrier overshoots under a large load, and the bound would then only halve the
         // gap again and again.
-        let scale = b
-            .gaps
+        let scale = gaps
+            .0
             .iter()
             .map(|&(d, g)| {
                 let closing = -g.dot(&step);
@@ -225,13 +232,14 @@ impl Local<'_> {
     /// energy with respect to its position (contacts in their band count no force, as in
     /// the update). Zero at the solution of the implicit-Euler equations.
     pub(in crate::integrator) fn force(&self, i: usize, x: &[Vec3]) -> Vec3 {
-        self.block(i, x).f
+        self.row(i, x).0
     }
 
     /// Particle `i`'s force (minus the gradient of its terms of the step's energy) and its
     /// diagonal Hessian block at positions `x`: a Newton system's row of it.
     pub(in crate::integrator) fn row(&self, i: usize, x: &[Vec3]) -> (Vec3, Sym3) {
-        let b = self.block(i, x);
+        let mut b = self.springs(i, x);
+        self.others(i, x, &mut b, &mut ());
         (b.f, b.h)
     }
 
@@ -359,35 +367,38 @@ impl Local<'_> {
     /// Hessian block without the springs' terms, which cancel over a body moved as a whole
     /// (and so are not computed).
     pub(in crate::integrator) fn translation(&self, i: usize, x: &[Vec3]) -> (Vec3, Sym3) {
-        let b = self.terms(i, x, false);
+        let mut b = self.inertia(i, x);
+        self.others(i, x, &mut b, &mut ());
         (b.f, b.h)
     }
 
-    /// Particle `i`'s force and Hessian block at positions `x`.
-    fn block(&self, i: usize, x: &[Vec3]) -> Block {
-        self.terms(i, x, true)
-    }
-
-    /// Particle `i`'s force and Hessian block at positions `x`, its springs' terms with
-    /// `springs`.
-    fn terms(&self, i: usize, x: &[Vec3], springs: bool) -> Block {
+    /// Particle `i`'s inertia and drag at positions `x`: where its block's sum starts.
+    fn inertia(&self, i: usize, x: &[Vec3]) -> Block {
         let dt = self.dt;
         let inertia = self.mass[i] / (dt * dt);
         let xi = x[i];
-        let moved = xi - self.start[i];
         let mut b = Block {
             f: (self.target[i] - xi) * inertia,
             h: Sym3::default().plus_identity(inertia),
-            gaps: Gaps::default(),
         };
         let model = self.model;
         if model.has_drag() {
+            let moved = xi - self.start[i];
             let drag = model.drag_on(self.mass[i]) / dt;
             b.f -= moved * drag;
             b.h = b.h.plus_identity(drag);
         }
-        let mine = if springs { self.graph.of(i) } else { &[] };
-        for nb in mine {
+        b
+    }
+
+    /// Particle `i`'s inertia, drag and springs at positions `x`, one particle at a time
+    /// (`lanes/` sums the same terms in the same order eight particles at a time).
+    pub(super) fn springs(&self, i: usize, x: &[Vec3]) -> Block {
+        let dt = self.dt;
+        let xi = x[i];
+        let moved = xi - self.start[i];
+        let mut b = self.inertia(i, x);
+        for nb in self.graph.of(i) {
             let j = nb.other as usize;
             let d = xi - x[j];
             let len = d.norm();
@@ -406,16 +417,24 @@ impl Local<'_> {
                     .plus_identity(nb.ks * transverse),
             );
         }
-        for a in model.attachments.iter().filter(|a| a.particle == i) {
-            b.f -= (xi - a.target) * a.ks + moved * (a.kd / dt);
-            b.h = b.h.plus_identity(a.ks + a.kd / dt);
-        }
-        self.colliders(i, &xi, moved, &mut b);
-        self.pairs(i, x, &mut b);
         b
     }
 
-    fn colliders(&self, i: usize, xi: &Vec3, moved: Vec3, b: &mut Block) {
+    /// Adds particle `i`'s attachments and contacts at positions `x` to its block `b`, their
+    /// gaps to `gaps`.
+    fn others(&self, i: usize, x: &[Vec3], b: &mut Block, gaps: &mut impl GapSink) {
+        let xi = x[i];
+        let moved = xi - self.start[i];
+        let dt = self.dt;
+        for a in self.model.attachments.iter().filter(|a| a.particle == i) {
+            b.f -= (xi - a.target) * a.ks + moved * (a.kd / dt);
+            b.h = b.h.plus_identity(a.ks + a.kd / dt);
+        }
+        self.colliders(i, &xi, moved, b, gaps);
+        self.pairs(i, x, b, gaps);
+    }
+
+    fn colliders(&self, i: usize, xi: &Vec3, moved: Vec3, b: &mut Block, gaps: &mut impl GapSink) {
         let touches = self.detection.touches[i].planes();
         if touches.is_empty() {
             return;
@@ -455,7 +474,7 @@ impl Local<'_> {
                     } else {
                         ((n, k * depth, k), None)
                     };
-                    b.contact(law, gap, mu, moved, 1.0, dt);
+                    b.contact(law, gap, mu, moved, 1.0, dt, gaps);
                 }
             }
         }
@@ -472,7 +491,7 @@ impl Local<'_> {
             > 0.0
     }
 
-    fn pairs(&self, i: usize, x: &[Vec3], b: &mut Block) {
+    fn pairs(&self, i: usize, x: &[Vec3], b: &mut Block, gaps: &mut impl GapSink) {
         for pair in self.detection.pairs_of(i) {
             let Some(c) = self.pair_contact(pair, x) else {
                 continue;
@@ -492,6 +511,7 @@ impl Local<'_> {
                 c.slip,
                 mine,
                 self.dt,
+                gaps,
             );
         }
     }

@@ -25,6 +25,7 @@ mod candidates;
 mod cells;
 pub(in crate::integrator) mod detect;
 pub(in crate::integrator) mod graph;
+mod lanes;
 pub(in crate::integrator) mod local;
 pub(in crate::integrator) mod pairs;
 mod planes;
@@ -37,7 +38,8 @@ use crate::model::Model;
 use crate::particles::{Particles, Vec3};
 use detect::Detection;
 use graph::Graph;
-use local::Local;
+use lanes::{LANES, Lanes};
+use local::{Block, Gaps, Local};
 use rayon::prelude::*;
 
 /// Block descent is implicit Euler: stable for every step.
@@ -47,13 +49,16 @@ pub(in crate::integrator) const STABILITY_RADIUS: f64 = f64::INFINITY;
 const DETECT_SHARE: f64 = 0.01;
 /// The spectral radius assumed by the Chebyshev acceleration (0: none).
 const CHEBYSHEV: f64 = 0.9;
-/// Particles per parallel chunk of a colour.
+/// Particles per parallel chunk of a colour (a whole number of the lanes' blocks).
 const CHUNK: usize = 256;
+const _: () = assert!(CHUNK.is_multiple_of(LANES));
 
 /// Buffers of the block-descent step, kept between steps.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct VbdBuffers {
     pub(in crate::integrator) graph: Graph,
+    /// The colours' springs laid out for the sweep's lanes.
+    lanes: Lanes,
     pub(in crate::integrator) detection: Detection,
     /// Inertial targets.
     pub(in crate::integrator) target: Vec<Vec3>,
@@ -98,6 +103,7 @@ pub(in crate::integrator) fn step(
     let mut clock = crate::integrator::Lap::start();
     let rule = ws.stop.unwrap_or(StopRule::VBD);
     let cancel = ws.cancel;
+    let kernel = ws.kernel.unwrap_or_else(crate::Kernel::detect);
     let n = p.len();
     prepare(model, p, (t, dt), ws, &mut clock);
     let b = &mut ws.vbd;
@@ -127,22 +133,30 @@ pub(in crate::integrator) fn step(
             target: &b.target,
             dt,
         };
-        for colour in &b.graph.colours {
-            let (x, detected, detection) = (&p.x, &b.detected, &b.detection);
+        b.lanes.follow(&b.graph, dt);
+        for (c, colour) in b.graph.colours.iter().enumerate() {
+            let (x, detected, detection, lanes) = (&p.x, &b.detected, &b.detection, &b.lanes);
             b.next.resize(colour.len(), (Vec3::zeros(), false));
-            let update = |ids: &[u32], out: &mut [(Vec3, bool)]| {
-                for (k, &i) in ids.iter().enumerate() {
-                    let i = i as usize;
-                    out[k] = clip(detection, detected, i, local.solve(i, x));
+            // `first`: the lanes' block the chunk starts at.
+            let update = |first: usize, ids: &[u32], out: &mut [(Vec3, bool)]| {
+                let mut gaps = Gaps::default();
+                let mut blocks = [Block::default(); LANES];
+                for (k, (ids, out)) in ids.chunks(LANES).zip(out.chunks_mut(LANES)).enumerate() {
+                    lanes.sum(kernel, (&local, x), (c, first + k, ids), &mut blocks);
+                    for ((&i, o), block) in ids.iter().zip(out).zip(blocks) {
+                        let i = i as usize;
+                        *o = clip(detection, detected, i, local.update(i, x, block, &mut gaps));
+                    }
                 }
             };
             if colour.len() <= CHUNK {
-                update(colour, &mut b.next);
+                update(0, colour, &mut b.next);
             } else {
                 colour
                     .par_chunks(CHUNK)
                     .zip(b.next.par_chunks_mut(CHUNK))
-                    .for_each(|(ids, out)| update(ids, out));
+                    .enumerate()
+                    .for_each(|(k, (ids, out))| update(k * (CHUNK / LANES), ids, out));
             }
             for (&i, &(xi, c)) in colour.iter().zip(&b.next) {
                 let i = i as usize;
