@@ -12,7 +12,7 @@
 //! (no fused multiply-adds), and a lane with no spring in a row keeps its sums as they were,
 //! so every kernel gives the same bits, as a test checks.
 
-use super::graph::Graph;
+use super::graph::{Graph, Neighbour};
 use super::local::{Block, Local};
 use crate::assembly::kernel::Kernel;
 use crate::particles::Vec3;
@@ -67,19 +67,26 @@ impl Stream {
         self.kd.clear();
         self.kd_dt.clear();
         for ids in colour.chunks(LANES) {
-            let of = |l: usize| ids.get(l).map_or(&[][..], |&i| graph.of(i as usize));
-            let rows = (0..LANES).map(|l| of(l).len()).max().unwrap_or(0);
+            let lists: [&[Neighbour]; LANES] =
+                from_fn(|l| ids.get(l).map_or(&[][..], |&i| graph.of(i as usize)));
+            let rows = lists.iter().map(|s| s.len()).max().unwrap_or(0);
             self.blocks.push((self.other.len() as u32, rows as u32));
-            let own: [u32; LANES] = from_fn(|l| *ids.get(l).unwrap_or(&ids[0]));
-            self.own.push(own.map(coordinate));
-            self.counts.push(from_fn(|l| of(l).len() as f64));
+            let own: [i32; LANES] = from_fn(|l| coordinate(*ids.get(l).unwrap_or(&ids[0])));
+            self.own.push(own);
+            self.counts.push(lists.map(|s| s.len() as f64));
             for r in 0..rows {
-                let nb = |l: usize| of(l).get(r);
-                self.other
-                    .push(from_fn(|l| coordinate(nb(l).map_or(own[l], |s| s.other))));
-                self.rest.push(from_fn(|l| nb(l).map_or(0.0, |s| s.rest)));
-                self.ks.push(from_fn(|l| nb(l).map_or(0.0, |s| s.ks)));
-                self.kd.push(from_fn(|l| nb(l).map_or(0.0, |s| s.kd)));
+                let (mut other, mut rest, mut ks, mut kd) =
+                    (own, [0.0; LANES], [0.0; LANES], [0.0; LANES]);
+                for (l, list) in lists.iter().enumerate() {
+                    if let Some(s) = list.get(r) {
+                        (other[l], rest[l], ks[l], kd[l]) =
+                            (coordinate(s.other), s.rest, s.ks, s.kd);
+                    }
+                }
+                self.other.push(other);
+                self.rest.push(rest);
+                self.ks.push(ks);
+                self.kd.push(kd);
             }
         }
     }
