@@ -261,6 +261,8 @@ unsafe fn sum_in<V: Wide>(
     let (first, rows) = stream.blocks[block];
     let own = &stream.own[block];
     let mass: Row = std::array::from_fn(|l| local.mass[own[l] as usize / 3]);
+    // The model's drag coefficient per lane, by its own rule; divided by `dt` in the lanes.
+    let drag_on: Row = mass.map(|m| model.drag_on(m));
     let mut f_out = [[0.0; LANES]; 3];
     let mut h_out = [[0.0; LANES]; 6];
     // SAFETY: every index in the stream is a coordinate of a particle of `x` (whose length
@@ -281,9 +283,7 @@ unsafe fn sum_in<V: Wide>(
             let diagonal = zero.add(inertia);
             let mut h = [diagonal, diagonal, diagonal, zero, zero, zero];
             if model.has_drag() {
-                let drag = V::splat(model.drag)
-                    .add(V::splat(model.mass_drag).mul(m))
-                    .div(dtv);
+                let drag = V::load(drag_on[base..].as_ptr()).div(dtv);
                 for c in 0..3 {
                     f[c] = f[c].sub(moved[c].mul(drag));
                     h[c] = h[c].add(drag);
