@@ -9,6 +9,7 @@ mod collisions;
 mod common;
 mod conservation;
 mod contact;
+mod creases;
 mod determinism;
 mod drape;
 mod friction;

@@ -25,6 +25,12 @@ pub struct ColliderSlot {
 /// ([`Model::point_thickness`]).
 pub(crate) const POINT_THICKNESS: f64 = 1e-3;
 
+/// How far, in its thicknesses, the large steps skip a surface's contacts with itself
+/// ([`Model::self_contact_skip`]): block descent's search reach between surfaces, so that
+/// no neighbour of a flat or gently curved sheet bounds its particles. Farther (eight
+/// thicknesses) let the shipped curtain's 5 cm quads fold through each other.
+pub(crate) const SELF_CONTACT_SKIP: f64 = 4.0;
+
 /// Springs, external forces and colliders, and the per-particle masses they act on.
 ///
 /// Forces are evaluated per docs/physics.md §1 by the spring assembly (`assembly/`), which sums them in an order
@@ -152,6 +158,21 @@ impl Model {
             .filter(|&r| r > 0.0)
             .fold(f64::INFINITY, f64::min);
         POINT_THICKNESS.min(0.25 * shortest)
+    }
+
+    /// The distance along a surface within which the large steps (`vbd`, `newton`) skip
+    /// its contacts with itself, metres: `SELF_CONTACT_SKIP` times the largest thickness of
+    /// the surfaces whose contacts are on (zero without one), four thicknesses. A particle and a triangle, or
+    /// two edges, of one surface that lie within it of each other in the rest shape, joined
+    /// through the surface's own triangles within it, are held apart by the surface's own
+    /// springs and never measured (docs/physics.md §4.1, "What self-contact skips"); a
+    /// crease that brings such a pair within a thickness can cross.
+    pub fn self_contact_skip(&self) -> f64 {
+        let h = self
+            .active_surfaces()
+            .map(|(_, s)| s.thickness)
+            .fold(0.0, f64::max);
+        SELF_CONTACT_SKIP * h
     }
 
     /// The contact thickness of particle `p`: its surface's, zero for particles outside

@@ -18,9 +18,9 @@
 //! positions then) differs, and no thread count changes it.
 
 use super::cells::{bin, bounds_of, boxes_within, by_cell, concatenate, within};
-use super::topology::Topology;
+use super::exclusion::Exclusion;
+use super::topology::{Topology, point_triangle_distance, segment_distance};
 use crate::contact::grid::{Cell, Grid};
-use crate::contact::proximity::{point_triangle, segment_segment};
 use crate::particles::Vec3;
 use rayon::prelude::*;
 
@@ -34,8 +34,8 @@ const CHUNK: usize = 4096;
 /// distance at its last exact test and its particles' travel summed then.
 #[derive(Clone, Copy, Debug)]
 pub(in crate::integrator) struct Candidate {
-    a: u32,
-    b: u32,
+    pub(in crate::integrator) a: u32,
+    pub(in crate::integrator) b: u32,
     distance: f64,
     travel: f64,
 }
@@ -56,18 +56,6 @@ pub(in crate::integrator) struct Candidates {
     last_mean: Vec3,
     point_tri: Vec<Candidate>,
     edge_edge: Vec<Candidate>,
-}
-
-/// The distance from `p` to triangle `abc`.
-fn point_triangle_distance(p: &Vec3, [a, b, c]: [&Vec3; 3]) -> f64 {
-    let w = point_triangle(p, a, b, c);
-    (p - (a * w[0] + b * w[1] + c * w[2])).norm()
-}
-
-/// The distance between segments `p1q1` and `p2q2`.
-fn segment_distance([p1, q1, p2, q2]: [&Vec3; 4]) -> f64 {
-    let (s, t) = segment_segment(p1, q1, p2, q2);
-    ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm()
 }
 
 /// The mean of the surface particles' positions (zero without any).
@@ -209,9 +197,9 @@ fn check(
 
 /// Every point–triangle pair (a surface particle, a triangle not holding it) and edge–edge
 /// pair (sharing no particle; each unordered pair once) of the surfaces within `reach` at
-/// `x`, measured, through the grids' search.
+/// `x` that `skip` does not hold apart, measured, through the grids' search.
 pub(in crate::integrator) fn search(
-    topo: &Topology,
+    (topo, skip): (&Topology, &Exclusion),
     x: &[Vec3],
     reach: f64,
     (triangle_grid, edge_grid): (&mut Grid, &mut Grid),
@@ -236,7 +224,10 @@ pub(in crate::integrator) fn search(
             let p = &x[v];
             for &t in candidates {
                 let (tri, _) = topo.triangles[t as usize];
-                if tri.contains(&(v as u32)) || !within(p, &tri_boxes[t as usize], reach) {
+                if tri.contains(&(v as u32))
+                    || !within(p, &tri_boxes[t as usize], reach)
+                    || skip.skips_triangle(v as u32, t)
+                {
                     continue;
                 }
                 let d = point_triangle_distance(p, tri.map(|i| &x[i as usize]));
@@ -281,7 +272,8 @@ pub(in crate::integrator) fn search(
                 if [c0, d0].contains(&a) || [c0, d0].contains(&b) {
                     continue;
                 }
-                if !boxes_within(bx, &edge_boxes[f], reach) {
+                if !boxes_within(bx, &edge_boxes[f], reach) || skip.skips_edges(e as u32, f as u32)
+                {
                     continue;
                 }
                 let d = segment_distance([a, b, c0, d0].map(|i| &x[i as usize]));
@@ -363,7 +355,7 @@ mod tests {
         let topo = Topology::new(&model, x.len());
         let reach = 0.013;
         let (point_tri, edge_edge) = search(
-            &topo,
+            (&topo, &Exclusion::default()),
             &x,
             reach,
             (&mut Grid::default(), &mut Grid::default()),

@@ -3,7 +3,9 @@
 //! and which triangle owns each shared edge and corner (so a pair is counted once).
 
 use crate::collider::response::Response;
+use crate::contact::proximity::{point_triangle, segment_segment};
 use crate::model::Model;
+use crate::particles::Vec3;
 
 /// The surfaces' primitives, fixed for a model.
 #[derive(Clone, Debug, Default)]
@@ -91,4 +93,16 @@ impl Topology {
             .collect();
         t
     }
+}
+
+/// The distance from `p` to triangle `abc`.
+pub(in crate::integrator) fn point_triangle_distance(p: &Vec3, [a, b, c]: [&Vec3; 3]) -> f64 {
+    let w = point_triangle(p, a, b, c);
+    (p - (a * w[0] + b * w[1] + c * w[2])).norm()
+}
+
+/// The distance between segments `p1q1` and `p2q2`.
+pub(in crate::integrator) fn segment_distance([p1, q1, p2, q2]: [&Vec3; 4]) -> f64 {
+    let (s, t) = segment_segment(p1, q1, p2, q2);
+    ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm()
 }

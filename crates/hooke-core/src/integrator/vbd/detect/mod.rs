@@ -22,6 +22,7 @@ mod colliders;
 pub(in crate::integrator) use colliders::collider_law;
 
 use super::candidates::{Candidates, SKIN, search};
+use super::exclusion::Exclusion;
 use super::graph::Graph;
 use super::pairs::{Pair, Sides, stencil_distance};
 use super::planes::{HalfSpaces, Touches};
@@ -37,6 +38,9 @@ pub(crate) const GAMMA_SURFACE: f64 = 0.4;
 pub(crate) const GAMMA_COLLIDER: f64 = 0.9;
 /// Reach of the search between surfaces, in thicknesses.
 const SURFACE_REACH: f64 = 4.0;
+// The skipped pairs cover the search's reach at rest, so that no neighbour bounds a flat
+// sheet's particles.
+const _: () = assert!(crate::model::SELF_CONTACT_SKIP >= SURFACE_REACH);
 /// Least reach of the search for colliders, in thicknesses.
 const COLLIDER_REACH: f64 = 10.0;
 /// Pairs nearer than this many thicknesses are felt until the next detection; farther ones
@@ -107,6 +111,8 @@ pub(in crate::integrator) struct Detection {
     /// Positions at the first step: pairs nearer than their gap there are neighbours in the
     /// body's own rest shape, not contacts.
     rest: Vec<Vec3>,
+    /// The pairs the surfaces' own structure holds apart, never measured (`exclusion.rs`).
+    exclusion: Exclusion,
     /// Per particle: the collider surfaces it may reach before the next detection, each as
     /// its tangent plane at the detection.
     pub(in crate::integrator) touches: Vec<Touches>,
@@ -244,6 +250,12 @@ impl Detection {
         if self.topology.built_for != n || self.rest.len() != n {
             self.topology = Topology::new(model, n);
             self.rest = x.to_vec();
+            self.exclusion = Exclusion::new(
+                &self.topology,
+                &self.rest,
+                model.self_contact_skip(),
+                &|i| p.is_pinned(i as usize),
+            );
         }
         self.scale.clear();
         self.scale
@@ -321,7 +333,7 @@ impl Detection {
             self.candidates.forget();
             let built = reach + SKIN * reach;
             let (point_tri, edge_edge) = search(
-                topo,
+                (topo, &self.exclusion),
                 x,
                 built,
                 (&mut self.triangle_grid, &mut self.edge_grid),

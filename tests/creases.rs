@@ -1,0 +1,163 @@
+//! Crease cases for block descent's self-contact (docs/physics.md §4.1, "What self-contact
+//! skips"): the detection skips the pairs a cloth's own structure holds apart, so a crease
+//! is where a crossing could hide. Each case is run at one step per 60 Hz frame, every step
+//! exported, and every frame read back with the crossing test that is independent of the
+//! solver (`hooke::report::crossings`): cloth pushed into a cup by a ball, a sheet folded
+//! tight over itself by its keyed edge, and a hanging sheet twisted one and a half turns.
+//! The pile and the stack of three cloths are `large_steps.rs`'s.
+
+use crate::common::root;
+use crate::contact::assert_scene_never_crosses;
+use hooke_scene::Scene;
+
+/// An `n`×`n` cotton-weight sheet `size` m wide (5 mm thickness, self-collision on) under
+/// block descent at 1/60 s for `duration` s, with `extra` TOML (pins, colliders) added to
+/// its body and scene.
+fn sheet(
+    n: usize,
+    size: f64,
+    origin: [f64; 3],
+    duration: f64,
+    (body, rest): (&str, &str),
+) -> Scene {
+    let text = format!(
+        r#"
+name = "crease"
+[simulation]
+integrator = "vbd"
+dt = 0.016666666666666666
+duration = {duration}
+every = 1
+gravity = [0.0, -9.81, 0.0]
+drag = 0.002
+[[body]]
+name = "sheet"
+mass = {mass}
+origin = [{}, {}, {}]
+thickness = 0.005
+self_collision = true
+friction = 0.3
+{body}
+[body.shape]
+kind = "grid"
+size = [{n}, {n}]
+spacing = {spacing}
+[body.springs.structural]
+ks = 300.0
+kd = 0.02
+[body.springs.shear]
+ks = 150.0
+kd = 0.02
+[body.springs.bend]
+ks = 5.0
+kd = 0.005
+{rest}
+"#,
+        origin[0],
+        origin[1],
+        origin[2],
+        mass = 0.12 / (n * n) as f64,
+        spacing = size / (n - 1) as f64,
+    );
+    hooke_scene::parse_scene(&text, "crease.toml")
+        .unwrap()
+        .build(&root().join("assets/scenes"))
+        .unwrap()
+}
+
+/// The highest point of the cloth in the last frame, and its lowest.
+fn heights(frame: &crate::contact::Frame) -> (f64, f64) {
+    let ys = frame.cloth.iter().flat_map(|(t, _)| t.iter().map(|p| p.y));
+    ys.fold((f64::MIN, f64::MAX), |(hi, lo), y| (hi.max(y), lo.min(y)))
+}
+
+/// An open cup 0.3 m wide and deep (a floor and four walls of a thin mesh), written as an
+/// OBJ file into the temporary folder; its path.
+fn cup() -> std::path::PathBuf {
+    let w = 0.15;
+    let corners = [[-w, 0.0, -w], [w, 0.0, -w], [w, 0.0, w], [-w, 0.0, w]];
+    let mut obj = String::new();
+    for y in [0.0, 0.3] {
+        for [x, _, z] in corners {
+            obj += &format!("v {x} {y} {z}\n");
+        }
+    }
+    // The floor (facing up, into the cup), then each wall as a quad.
+    obj += "f 1 4 3 2\n";
+    for k in 0..4 {
+        let (a, b) = (k + 1, (k + 1) % 4 + 1);
+        obj += &format!("f {a} {b} {} {}\n", b + 4, a + 4);
+    }
+    let path = std::env::temp_dir().join(format!("hooke-crease-cup-{}.obj", std::process::id()));
+    std::fs::write(&path, obj).unwrap();
+    path
+}
+
+/// A 0.6 m sheet lying over an open cup 0.3 m wide, pushed to near its floor by a ball
+/// 0.24 m across: the cloth is drawn in over the rim and folds on itself between the ball
+/// and the walls.
+#[test]
+fn cloth_pushed_into_a_cup_by_a_ball_never_crosses() {
+    let cup = cup();
+    let colliders = format!(
+        r#"
+[[collider]]
+shape = {{ kind = "ground", height = 0.0 }}
+response = {{ kind = "restitution", cr = 0.0, friction = 0.5 }}
+[[collider]]
+shape = {{ kind = "mesh", path = "{}" }}
+response = {{ kind = "restitution", cr = 0.0, friction = 0.3 }}
+[[collider]]
+shape = {{ kind = "sphere", center = [0.0, 0.45, 0.0], radius = 0.12 }}
+response = {{ kind = "restitution", cr = 0.0, friction = 0.3 }}
+motion = {{ keys = [{{ t = 0.3, translate = [0.0, 0.0, 0.0] }}, {{ t = 1.8, translate = [0.0, -0.3, 0.0] }}] }}
+"#,
+        cup.display()
+    );
+    let scene = sheet(30, 0.6, [-0.3, 0.31, -0.3], 2.5, ("", &colliders));
+    let last = assert_scene_never_crosses(scene, "crease-cup");
+    std::fs::remove_file(&cup).unwrap();
+    // Pushed in under the ball (whose bottom ends 3 cm above the floor), its edges still
+    // over the rim.
+    let (hi, lo) = heights(&last);
+    assert!(lo < 0.06 && hi > 0.2, "cloth spans {lo}..{hi} m");
+}
+
+/// A 0.4 m sheet lying on the ground, its first row keyed up, over and down onto its last:
+/// folded tight on itself, two layers a thickness apart along the crease.
+#[test]
+fn a_sheet_folded_tight_on_itself_never_crosses() {
+    let pins = r#"
+pins = { box = [[-0.01, -0.01, -0.01], [0.41, 0.01, 0.01]] }
+pin_motion = { keys = [{ t = 0.0, translate = [0.0, 0.0, 0.0] }, { t = 0.8, translate = [0.0, 0.12, 0.2] }, { t = 1.6, translate = [0.0, 0.012, 0.39] }] }
+"#;
+    let ground = r#"
+[[collider]]
+shape = { kind = "ground", height = 0.0 }
+response = { kind = "restitution", cr = 0.0, friction = 0.5 }
+"#;
+    let scene = sheet(24, 0.4, [0.0, 0.0055, 0.0], 2.5, (pins, ground));
+    let last = assert_scene_never_crosses(scene, "crease-fold");
+    // Folded: two layers, the top one resting on the bottom one.
+    let (hi, _) = heights(&last);
+    assert!(hi < 0.05, "the fold stands {hi} m high");
+}
+
+/// A 0.4 m sheet hanging from its top row, which turns one and a half times about the
+/// vertical through its middle in 2 s: the sheet winds on itself.
+#[test]
+fn a_hanging_sheet_twisted_on_itself_never_crosses() {
+    let pins = r#"
+pins = { box = [[-0.01, -0.01, -0.01], [0.41, 0.01, 0.01]] }
+pin_motion = { keys = [{ t = 0.0, translate = [0.0, 0.0, 0.0] }, { t = 0.66, translate = [0.0, 0.0, 0.0], rotate = [0.0, 180.0, 0.0] }, { t = 1.33, translate = [0.0, 0.0, 0.0], rotate = [0.0, 360.0, 0.0] }, { t = 2.0, translate = [0.0, 0.0, 0.0], rotate = [0.0, 540.0, 0.0] }] }
+"#;
+    let ground = r#"
+[[collider]]
+shape = { kind = "ground", height = 0.0 }
+response = { kind = "restitution", cr = 0.0, friction = 0.5 }
+"#;
+    // Hung in the x-y plane: turned 90° about x, its first row on top.
+    let pins = format!("rotate = [90.0, 0.0, 0.0]\n{pins}");
+    let scene = sheet(24, 0.4, [-0.2, 1.0, 0.0], 2.5, (&pins, ground));
+    assert_scene_never_crosses(scene, "crease-twist");
+}
