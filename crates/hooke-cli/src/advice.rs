@@ -45,6 +45,21 @@ pub(crate) fn recommend(scene: &Scene, estimate: &StabilityEstimate, dt: f64) ->
         format!("above the step that keeps contacts from being crossed ({crossing:.3e} s)")
     };
     let stiff = volumetric_bodies(scene);
+    if !stiff.is_empty()
+        && let Some(cost) = newton_cost(scene)
+    {
+        // One recommendation, consistent with the warning `run` gives for Newton here.
+        return Advice {
+            integrator: Integrator::Vbd,
+            why: format!(
+                "dt = {} s is {limit}; {} a volumetric or stiff body, on which Newton's global \
+                 solve converges faster, but {cost}; block descent keeps the same bounds, and \
+                 its steps on that body may end at their iteration budget",
+                Num(dt),
+                subject(&stiff.into_iter().map(|(name, _)| name).collect::<Vec<_>>())
+            ),
+        };
+    }
     if !stiff.is_empty() {
         return Advice {
             integrator: Integrator::Newton,
@@ -134,9 +149,12 @@ pub(crate) fn large_step_promises(scene: &Scene, integrator: Integrator) -> Vec<
     if !surfaces.is_empty() {
         out.push(format!(
             "{name} guarantees: no surface crosses another or itself at any dt (bodies with a \
-             contact thickness: '{}'); bodies without one ({}) are not kept apart from each \
-             other",
+             contact thickness: '{}'), but where a crease brings two points of one surface \
+             that were within {:.1} mm of each other at rest, and near along it, to within its \
+             thickness (its own contacts there are skipped, docs/physics.md §4.1); bodies \
+             without one ({}) are not kept apart from each other",
             surfaces.join("', '"),
+            1e3 * model.self_contact_skip(),
             {
                 let others: Vec<String> = scene
                     .bodies
