@@ -125,7 +125,7 @@ pub enum MeshError {
 
 /// Reads an OBJ file and places it.
 pub fn load_obj(path: &Path, placement: &Placement) -> Result<Vec<MeshPart>, MeshError> {
-    let text = std::fs::read_to_string(path).map_err(|source| MeshError::Io {
+    let text = hooke_core::text::read_text(path).map_err(|source| MeshError::Io {
         path: path.to_path_buf(),
         source,
     })?;

@@ -46,7 +46,7 @@ pub struct PolygonMesh {
 impl PolygonMesh {
     /// Reads `path` (see [`PolygonMesh::parse`]).
     pub fn load(path: &Path, limit: usize) -> Result<Self, MeshError> {
-        let text = std::fs::read_to_string(path).map_err(|source| MeshError::Io {
+        let text = hooke_core::text::read_text(path).map_err(|source| MeshError::Io {
             path: path.to_path_buf(),
             source,
         })?;

@@ -51,6 +51,7 @@ mod excerpt;
 mod keyframes;
 mod number;
 mod parallel;
+pub mod text;
 
 pub use assembly::kernel::Kernel;
 pub use collider::moving::Moving;

@@ -59,7 +59,7 @@ pub(crate) fn mesh_text(path: &str, base: &Path) -> Result<(String, PathBuf), Me
         };
     }
     let full = base.join(path);
-    let text = std::fs::read_to_string(&full).map_err(|source| MeshError::Io {
+    let text = hooke_core::text::read_text(&full).map_err(|source| MeshError::Io {
         path: full.clone(),
         source,
     })?;

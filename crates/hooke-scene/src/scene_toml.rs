@@ -104,7 +104,7 @@ fn locate(text: &str, offset: usize, message: &str) -> String {
 
 /// Reads a scene file.
 pub fn load_scene(path: &Path) -> Result<SceneSpec, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+    let text = hooke_core::text::read_text(path).map_err(|source| SceneError::Io {
         path: path.to_path_buf(),
         source,
     })?;

@@ -201,7 +201,7 @@ impl<'a> Tokens<'a> {
 
 /// Reads a `.w` file.
 pub fn load_world(path: &Path) -> Result<World, WorldError> {
-    let text = std::fs::read_to_string(path).map_err(|source| WorldError::Io {
+    let text = hooke_core::text::read_text(path).map_err(|source| WorldError::Io {
         path: path.to_path_buf(),
         source,
     })?;
