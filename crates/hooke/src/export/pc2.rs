@@ -28,6 +28,54 @@ const COUNT_OFFSET: u64 = 28;
 /// The header's length in bytes.
 pub const HEADER_BYTES: u64 = 32;
 
+/// The last line of the mesh a cache writes beside it: this prefix and a hash of every
+/// line before it, so that a later export knows the file for its own and unchanged.
+const SIGNATURE: &str = "# hooke mesh, fnv-1a of the lines above: ";
+
+/// The 64-bit FNV-1a hash of `bytes`.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+/// Whether the text of `mesh` is a mesh an export wrote and nobody changed since: its last
+/// line is [`SIGNATURE`] with the hash of the lines above it.
+fn written_by_hooke(text: &str) -> bool {
+    let body = text.strip_suffix('\n').unwrap_or(text);
+    let Some(cut) = body.rfind('\n') else {
+        return false;
+    };
+    let (above, last) = (&text[..=cut], &body[cut + 1..]);
+    last.strip_prefix(SIGNATURE)
+        .and_then(|h| u64::from_str_radix(h, 16).ok())
+        .is_some_and(|h| h == fnv1a(above.as_bytes()))
+}
+
+/// Refuses to write the cache `pc2`'s mesh over a file at `mesh` that an earlier export did
+/// not write, or that was changed since: the user's own OBJ (a cloth made from `flag.obj`,
+/// exported as `flag.pc2`) is never replaced.
+fn refuse_foreign_mesh(pc2: &Path, mesh: &Path) -> Result<()> {
+    let Ok(meta) = std::fs::symlink_metadata(mesh) else {
+        return Ok(());
+    };
+    // Links, devices and the like are refused, by name, when the file is created.
+    if !meta.is_file() {
+        return Ok(());
+    }
+    let ours = hooke_core::text::read_text(mesh).is_ok_and(|t| written_by_hooke(&t));
+    if !ours {
+        bail_output!(
+            "--export {}: its mesh goes to {}, which is already there and was not written by \
+             an earlier export (or was changed since); hooke does not replace it: move it, or \
+             export under another name",
+            pc2.display(),
+            mesh.display()
+        );
+    }
+    Ok(())
+}
+
 /// A point cache being written.
 pub struct Pc2Export {
     path: PathBuf,
@@ -78,20 +126,24 @@ impl Pc2Export {
                 ))
             })?;
         let mesh = path.with_extension("obj");
+        refuse_foreign_mesh(path, &mesh)?;
         let mut obj = OutputFile::create_named(&mesh, "--export (its mesh)")?;
         let sim = &scene.simulation;
         let x = &sim.particles().x;
         let springs = &sim.model().springs;
         (|| -> std::io::Result<()> {
-            let w = obj.writer();
+            let mut text = Vec::new();
             writeln!(
-                w,
+                text,
                 "# hooke: scene {}, body {} at the start (the mesh of {}), metres, +Y up",
                 scene.spec.name,
                 body.name,
                 path.file_name().unwrap_or_default().to_string_lossy()
             )?;
-            super::obj::write_body(w, body, x, springs, Default::default()).map(|_| ())
+            super::obj::write_body(&mut text, body, x, springs, Default::default())?;
+            let w = obj.writer();
+            w.write_all(&text)?;
+            writeln!(w, "{SIGNATURE}{:016x}", fnv1a(&text))
         })()
         .with_context(|| format!("cannot write {}", mesh.display()))?;
         obj.commit()?;
@@ -159,5 +211,20 @@ impl crate::Sink for Pc2Export {
             self.count,
             self.path.with_extension("obj").display()
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_exports_mesh_is_known_by_its_signature_and_a_changed_one_is_not() {
+        let above = "# hooke: scene flag\no body:flag\nv 0 0 0\n";
+        let ours = format!("{above}{SIGNATURE}{:016x}\n", fnv1a(above.as_bytes()));
+        assert!(written_by_hooke(&ours));
+        assert!(!written_by_hooke(&ours.replace("v 0 0 0", "v 0 0 1")));
+        assert!(!written_by_hooke(above));
+        assert!(!written_by_hooke(""));
     }
 }
