@@ -7,7 +7,7 @@ use clap::Args;
 use hooke::drape::{Meter, Repeat, Summary, fit_bending};
 use hooke_core::Integrator;
 use hooke_scene::material::{Material, PRESETS};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// `hooke drape`'s arguments.
@@ -23,7 +23,7 @@ pub struct DrapeArgs {
     #[arg(long, default_value_t = 5)]
     pub repeats: u32,
     /// The first repeat's seed (repeat k uses seed + k); the same seeds give the same bits.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub seed: u64,
     /// Print one JSON line instead of text.
     #[arg(long)]
@@ -36,38 +36,38 @@ pub struct DrapeArgs {
     pub still: Option<PathBuf>,
     /// Find the bending rigidity that gives this drape coefficient (bisection on log B to
     /// 2 %, each try the mean of --repeats repeats from the same seeds).
-    #[arg(long, value_name = "DC")]
+    #[arg(long, value_name = "DC", allow_negative_numbers = true)]
     pub fit_dc: Option<f64>,
     /// The specimen's own mesh: an OBJ disc of --size across, centred on the origin in the
     /// x–z plane (default: the built-in disc of irregular triangles on rings 1 cm apart).
     #[arg(long, value_name = "FILE.obj")]
     pub mesh: Option<PathBuf>,
     /// Coulomb friction of the cloth on the pedestal and between its folds.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
     pub friction: f64,
     /// Integrator (default symplectic Euler at its own step; vbd and newton at 1/60 s).
     #[arg(long)]
     pub integrator: Option<hooke_core::Integrator>,
     /// The step, seconds.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub dt: Option<f64>,
     /// The longest a repeat runs, simulated seconds, before it is measured unsettled.
-    #[arg(long, default_value_t = 15.0)]
+    #[arg(long, default_value_t = 15.0, allow_negative_numbers = true)]
     pub longest: f64,
     /// Areal density, kg/m².
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub density: Option<f64>,
     /// Membrane stiffness per unit width, N/m.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub stretch: Option<f64>,
     /// Shear stiffness per unit width, N/m.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub shear: Option<f64>,
     /// Bending rigidity per unit width, N·m.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub bending: Option<f64>,
     /// Stiffness-proportional damping, s.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub damping: Option<f64>,
 }
 
@@ -84,7 +84,7 @@ fn material(args: &DrapeArgs) -> Result<(String, Material)> {
             });
         } else {
             let path = PathBuf::from(m);
-            let text = std::fs::read_to_string(&path).map_err(|e| {
+            let text = hooke_core::text::read_text(&path).map_err(|e| {
                 anyhow!(format!(
                     "{m}: not a preset ({}) and not a file I can read: {e}",
                     PRESETS.map(|p| p.name).join(", ")
@@ -111,11 +111,19 @@ fn material(args: &DrapeArgs) -> Result<(String, Material)> {
         }
     };
     use hooke_scene::spec::{NonNegative, Positive};
-    if let Some(x) = set(args.density, "density")? {
-        spec.density = Some(Positive::of(x.max(f64::MIN_POSITIVE)));
+    let positive = |v: Option<f64>, key: &str| -> Result<Option<f64>> {
+        match v {
+            Some(x) if !(x.is_finite() && x > 0.0) => Err(anyhow!(format!(
+                "--{key}: expected a finite number above 0, found {x}"
+            ))),
+            _ => Ok(v),
+        }
+    };
+    if let Some(x) = positive(args.density, "density")? {
+        spec.density = Some(Positive::of(x));
     }
-    if let Some(x) = set(args.stretch, "stretch")? {
-        spec.stretch = Some(Positive::of(x.max(f64::MIN_POSITIVE)));
+    if let Some(x) = positive(args.stretch, "stretch")? {
+        spec.stretch = Some(Positive::of(x));
     }
     if let Some(x) = set(args.shear, "shear")? {
         spec.shear = Some(NonNegative::of(x));
@@ -135,6 +143,10 @@ fn material(args: &DrapeArgs) -> Result<(String, Material)> {
         .map_err(|e| anyhow!(e.to_string()))?;
     Ok((name, m))
 }
+
+/// The most `--repeats`: a lab's five, or many more for statistics, but not a run that
+/// never ends.
+const MOST_REPEATS: u32 = 1000;
 
 /// The relative bracket `--fit-dc` bisects `log B` to.
 const FIT_TOLERANCE: f64 = 0.02;
@@ -203,10 +215,32 @@ pub fn drape(args: &DrapeArgs) -> Result<ExitCode> {
     for (path, flag) in [(&args.top, "--top"), (&args.still, "--still")] {
         if let Some(p) = path {
             hooke::output::check_output_file(p, flag, &["png"])?;
+            // The pictures are written as names hooke chooses are (never through a link):
+            // refused now, not after the whole run.
+            hooke::output::check_named(p, flag)?;
         }
     }
-    if args.repeats == 0 {
-        return Err(anyhow!("--repeats: expected at least 1"));
+    // No picture over another, nor over the material or mesh the run reads.
+    let mut claims = hooke::output::claims::Claims::default();
+    if let Some(m) = &args.material
+        && Path::new(m).is_file()
+    {
+        claims.input("the material file", Path::new(m));
+    }
+    if let Some(mesh) = &args.mesh {
+        claims.input("the specimen's mesh (--mesh)", mesh);
+    }
+    for (path, flag) in [(&args.top, "--top"), (&args.still, "--still")] {
+        if let Some(p) = path {
+            claims.file(flag, p);
+        }
+    }
+    claims.check()?;
+    if !(1..=MOST_REPEATS).contains(&args.repeats) {
+        return Err(anyhow!(
+            "--repeats: expected from 1 to {MOST_REPEATS}, found {}",
+            args.repeats
+        ));
     }
     if !(args.longest.is_finite() && args.longest > 0.0 && args.longest <= 600.0) {
         return Err(anyhow!(
@@ -241,9 +275,13 @@ pub fn drape(args: &DrapeArgs) -> Result<ExitCode> {
     };
     let (name, m) = material(args)?;
     if let Some(target) = args.fit_dc {
-        if !(0.0..=1.0).contains(&target) {
+        // A disc hanging straight down covers the pedestal; a rigid one its own area.
+        let least = (meter.pedestal / meter.specimen).powi(2);
+        if !(target > least && target < 1.0) {
             return Err(anyhow!(format!(
-                "--fit-dc: a drape coefficient is between 0 and 1, found {target}"
+                "--fit-dc: a drape coefficient lies between the pedestal's share of the \
+                 specimen, {least:.3} (a disc hanging straight down), and 1 (a rigid disc), \
+                 both excluded; found {target}"
             )));
         }
         let mut unsettled = 0;
@@ -255,6 +293,14 @@ pub fn drape(args: &DrapeArgs) -> Result<ExitCode> {
         };
         let fit = fit_bending(target, &m, FIT_TOLERANCE, &mut evaluate)?;
         let (bending, dc) = (fit.bending, fit.dc);
+        if fit.outside(target) {
+            let (lo, hi) = hooke::drape::FIT_RANGE;
+            return Err(anyhow!(format!(
+                "--fit-dc {target}: no bending rigidity from {lo:.0e} to {hi:.0e} N·m gives it \
+                 with these density, stretch and shear: the nearest is DC {dc:.3}, at B = \
+                 {bending:.3e} N·m; change --density, --stretch or --shear, or the target"
+            )));
+        }
         if args.json {
             let line = serde_json::json!({
                 "target_dc": target, "bending": bending, "dc": dc,

@@ -91,6 +91,10 @@ impl Meter {
     /// The specimen's mesh path as a scene names it.
     fn mesh_path(&self) -> Result<String> {
         if let Some(path) = &self.mesh {
+            // A mesh shipped with Hooke, by the name the docs give it.
+            if let Some(name) = path.to_str().filter(|p| p.starts_with("builtin:")) {
+                return Ok(name.to_string());
+            }
             let full = std::path::absolute(path)
                 .map_err(|e| crate::Error::input(format!("{}: {e}", path.display())))?;
             let text = full.display().to_string();
@@ -207,8 +211,31 @@ response = {{ kind = "restitution", cr = 0.0, friction = {friction:e} }}
         let Some(path) = &self.mesh else {
             return Ok(());
         };
-        let mesh = hooke_collide::PolygonMesh::load(path, hooke_scene::MAX_PARTICLES)
-            .map_err(|e| crate::Error::input(e.to_string()))?;
+        let builtin = path
+            .to_str()
+            .and_then(|p| p.strip_prefix("builtin:"))
+            .map(|name| {
+                hooke_scene::BUILTIN_MESHES
+                    .iter()
+                    .find(|(n, _)| *n == name)
+                    .map(|(_, text)| text())
+                    .ok_or_else(|| {
+                        let names = hooke_scene::BUILTIN_MESHES.map(|m| m.0);
+                        crate::Error::input(format!(
+                            "--mesh {}: no such built-in mesh; they are {}",
+                            path.display(),
+                            names.join(", ")
+                        ))
+                    })
+            })
+            .transpose()?;
+        let mesh = match builtin {
+            Some(text) => {
+                hooke_collide::PolygonMesh::parse(&text, path, hooke_scene::MAX_PARTICLES)
+            }
+            None => hooke_collide::PolygonMesh::load(path, hooke_scene::MAX_PARTICLES),
+        }
+        .map_err(|e| crate::Error::input(e.to_string()))?;
         let used: std::collections::BTreeSet<u32> = mesh
             .faces
             .iter()
@@ -487,6 +514,20 @@ pub struct Fit {
     pub evaluations: usize,
 }
 
+impl Fit {
+    /// Whether the target lies outside what the fit's range of `B` gives: the bracket never
+    /// left one end of it ([`FIT_RANGE`]) and the last DC is more than a jump's height
+    /// (0.02) from the target.
+    pub fn outside(&self, target: f64) -> bool {
+        let at_end = |b: f64, end: f64| (b / end - 1.0).abs() < 1e-9;
+        (at_end(self.bracket.0, FIT_RANGE.1) || at_end(self.bracket.1, FIT_RANGE.0))
+            && (self.dc - target).abs() > 0.02
+    }
+}
+
+/// The range of bending rigidity `fit_bending` searches, N·m.
+pub const FIT_RANGE: (f64, f64) = (1e-7, 1e-3);
+
 /// The bending rigidity that gives `target` DC with `material`'s other values, by
 /// bisection on `log B` between 0.1 and 1000 µN·m (DC rises with `B`) until the bracket
 /// is within `tolerance` relative, or DC within 0.002 of the target; `evaluate` gives the
@@ -498,7 +539,7 @@ pub fn fit_bending(
     tolerance: f64,
     evaluate: &mut dyn FnMut(&Material) -> Result<f64>,
 ) -> Result<Fit> {
-    let (mut lo, mut hi) = (1e-7f64.ln(), 1e-3f64.ln());
+    let (mut lo, mut hi) = (FIT_RANGE.0.ln(), FIT_RANGE.1.ln());
     let mut fit = Fit {
         bending: f64::NAN,
         dc: f64::NAN,
