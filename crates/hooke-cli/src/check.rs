@@ -115,23 +115,26 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
              leave a surface through a collider (the run warns at the first step that does)"
         );
     }
+    // These concern the scene's own integrator, whose contacts come after its step; the
+    // large steps keep the bounds stated above instead.
+    let who = format!("{} (the scene's integrator)", sim.integrator().name());
     for t in tunnelling(&scene) {
         if t.risky() {
             println!(
-                "warning: tunnelling: {}; keep dt below {:.3e} s",
+                "warning: tunnelling under {who}: {}; keep dt below {:.3e} s",
                 t.describe(dt),
                 t.safe_dt
             );
         } else {
             println!(
-                "thin collider: {}: no tunnelling below dt = {:.3e} s",
+                "thin collider under {who}: {}: no tunnelling below dt = {:.3e} s",
                 t.describe(dt),
                 t.safe_dt
             );
         }
     }
     for message in thin_surfaces(&scene) {
-        println!("warning: tunnelling: {message}");
+        println!("warning: tunnelling under {who}: {message}");
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -261,7 +261,12 @@ pub(crate) fn volumetric_bodies(scene: &Scene) -> Vec<(String, String)> {
             ) {
                 "is a volumetric lattice".to_string()
             } else if stiffness > STIFF {
-                format!("has springs with ks dt²/m up to {stiffness:.1e}")
+                let mesh = if b.topology == hooke_scene::Topology::Mesh {
+                    slivers(&b.triangles, &sim.particles().x)
+                } else {
+                    String::new()
+                };
+                format!("has springs with ks dt²/m up to {stiffness:.1e}{mesh}")
             } else {
                 return None;
             };
@@ -283,3 +288,37 @@ pub(crate) fn volumetric_bodies(scene: &Scene) -> Vec<(String, String)> {
 /// cloth (a 2000 N/m strip at 1 cm spacing is 1e5 at 1/60 s and diverged; the built-in
 /// cloths are below 1e3).
 const STIFF: f64 = 1e4;
+
+/// What makes a cloth mesh stiff, said so its user can remesh it: its shortest and longest
+/// edges and how many of its triangles are slivers (an edge under a tenth of their longest,
+/// whose short springs set the step).
+fn slivers(triangles: &[[u32; 3]], x: &[hooke_core::Vec3]) -> String {
+    let (mut shortest, mut longest, mut thin) = (f64::INFINITY, 0.0f64, 0usize);
+    for t in triangles {
+        let edges =
+            [(0, 1), (1, 2), (2, 0)].map(|(a, b)| (x[t[a] as usize] - x[t[b] as usize]).norm());
+        let (lo, hi) = edges.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &e| {
+            (lo.min(e), hi.max(e))
+        });
+        shortest = shortest.min(lo);
+        longest = longest.max(hi);
+        thin += usize::from(lo < 0.1 * hi);
+    }
+    if triangles.is_empty() {
+        return String::new();
+    }
+    format!(
+        " (its mesh's edges run from {:.3} mm to {:.1} mm{}; remesh it to even triangles, \
+         for example with Blender's Remesh or Triangulate modifier)",
+        shortest * 1e3,
+        longest * 1e3,
+        if thin > 0 {
+            format!(
+                ", and {thin} of its {} triangles are slivers, with an edge under a tenth of their longest",
+                triangles.len()
+            )
+        } else {
+            String::new()
+        }
+    )
+}

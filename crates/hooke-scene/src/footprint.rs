@@ -124,7 +124,12 @@ impl SceneSpec {
             let key = format!("body[{b}] '{}'", body.name);
             if let Some(path) = body.shape.mesh_path() {
                 let (particles, springs) = mesh_estimate(&body.shape, path, base);
-                f.add_body(format!("{key}.shape.path"), particles, springs, particles);
+                // A solid's lattice grows with its spacing, a cloth with its mesh.
+                let part = match body.shape {
+                    ShapeSpec::Solid { .. } => "spacing",
+                    _ => "path",
+                };
+                f.add_body(format!("{key}.shape.{part}"), particles, springs, particles);
                 continue;
             }
             let (lattice, size_key) = match &body.shape {

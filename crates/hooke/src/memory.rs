@@ -137,7 +137,9 @@ pub fn check(name: &str, footprint: &Footprint) -> Result<()> {
         .as_ref()
         .map(|(k, b)| {
             let advice = if k.ends_with(".path") {
-                "use a mesh with fewer triangles"
+                "use a mesh with fewer vertices"
+            } else if k.ends_with(".spacing") {
+                "make the spacing larger"
             } else {
                 "make it smaller"
             };
@@ -148,8 +150,17 @@ pub fn check(name: &str, footprint: &Footprint) -> Result<()> {
         "scene '{name}' would need about {} ({} particles, {} springs), more than the {} of \
          {source}{key}",
         human(need),
-        footprint.particles,
-        footprint.springs,
+        count(footprint.particles),
+        count(footprint.springs),
         human(budget)
     )
+}
+
+/// A count that may have saturated while it was estimated.
+fn count(n: u64) -> String {
+    if n == u64::MAX {
+        format!("more than {:.1e}", u64::MAX as f64)
+    } else {
+        n.to_string()
+    }
 }
