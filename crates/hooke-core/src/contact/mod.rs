@@ -32,128 +32,33 @@
 //! detection are split into a fixed number of chunks whose results are read in order:
 //! results are the same bits on any thread count.
 
+mod budgets;
+mod gather;
 pub(crate) mod grid;
 pub mod proximity;
 mod respond;
+mod stencil;
 
 use crate::collider::Feature;
-use crate::collider::response::{Response, coulomb_cut};
+use crate::collider::response::coulomb_cut;
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
-use grid::Grid;
+use budgets::{Budgets, next_budget};
+use gather::{Bins, Prims, append, overlap, pair, par_fill};
 use proximity::{
     ball_triangle, circle_triangle, point_triangle, segment_segment, segment_triangle,
 };
-use rayon::prelude::*;
 use respond::{FaceSkip, respond_all, respond_one};
 use std::time::Instant;
+use stencil::{Rule, Stencil};
 
 /// Gauss–Seidel sweeps over the proximities. Proximities that the pushes create are found
 /// on the next step, while still a thickness from crossing.
 const SWEEPS: usize = 4;
 /// Velocity sweeps.
 const VELOCITY_SWEEPS: usize = 2;
-/// Gaps shorter than this have no direction of their own.
-const EPS: f64 = 1e-12;
 /// No surface particle.
 const NONE: u32 = u32::MAX;
-
-/// How a stencil's velocity responds.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Rule {
-    /// Surface against surface: inelastic, Coulomb friction with this coefficient.
-    Coulomb(f64),
-    /// Against a collider with restitution `cr` and Coulomb friction `mu`.
-    Bounce { cr: f64, mu: f64 },
-    /// Against a stick collider: the touching point stops.
-    Stop,
-}
-
-impl Rule {
-    fn of(response: &Response) -> Self {
-        match *response {
-            Response::Restitution { cr, friction } => Self::Bounce { cr, mu: friction },
-            Response::Stick => Self::Stop,
-            Response::Penalty { .. } => Self::Bounce { cr: 0.0, mu: 0.0 },
-        }
-    }
-}
-
-/// A proximity: `Σ w_k x_k - anchor` is the gap between its two sides.
-#[derive(Clone, Copy, Debug)]
-struct Stencil {
-    ids: [u32; 4],
-    w: [f64; 4],
-    /// 3 (a triangle against a fixed collider point) or 4.
-    len: usize,
-    /// The collider's point (zero for surface pairs).
-    anchor: Vec3,
-    /// The collider's velocity at `anchor` over the step (zero for surface pairs and still
-    /// colliders).
-    anchor_velocity: Vec3,
-    /// The gap's unit normal.
-    n: Vec3,
-    /// The gap to keep, metres.
-    h: f64,
-    rule: Rule,
-}
-
-impl Stencil {
-    /// A surface pair: weights `w` on particles `ids`, kept `h` apart, friction `mu`.
-    fn surface(ids: [u32; 4], w: [f64; 4], h: f64, mu: f64) -> Self {
-        Self {
-            ids,
-            w,
-            len: 4,
-            anchor: Vec3::zeros(),
-            anchor_velocity: Vec3::zeros(),
-            n: Vec3::zeros(),
-            h,
-            rule: Rule::Coulomb(mu),
-        }
-    }
-
-    fn gap(&self, x: &[Vec3]) -> Vec3 {
-        let mut g = -self.anchor;
-        for k in 0..self.len {
-            g += x[self.ids[k] as usize] * self.w[k];
-        }
-        g
-    }
-
-    /// `Σ w_k² / m_k`: how far the gap moves per unit impulse.
-    fn compliance(&self, inv_mass: &[f64]) -> f64 {
-        (0..self.len)
-            .map(|k| self.w[k] * self.w[k] * inv_mass[self.ids[k] as usize])
-            .sum()
-    }
-
-    /// Adds `w_k / m_k · j` to each particle's entry of `y`.
-    fn spread(&self, inv_mass: &[f64], y: &mut [Vec3], j: Vec3) {
-        for k in 0..self.len {
-            let i = self.ids[k] as usize;
-            y[i] += j * (self.w[k] * inv_mass[i]);
-        }
-    }
-
-    /// Orients the stencil at `x` (see the module docs) and returns its signed gap along the
-    /// normal, or `None` when no direction can be told.
-    fn orient(&mut self, x: &[Vec3], x0: &[Vec3]) -> Option<f64> {
-        let now = self.gap(x);
-        let start = self.gap(x0);
-        let d = now.norm();
-        if d > EPS && now.dot(&start) > 0.0 {
-            self.n = now / d;
-            Some(d)
-        } else {
-            let d0 = start.norm();
-            (d0 > EPS).then(|| {
-                self.n = start / d0;
-                now.dot(&self.n)
-            })
-        }
-    }
-}
 
 /// Contact figures, for benchmarks.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -547,282 +452,6 @@ impl ContactState {
     }
 }
 
-/// A model's contact primitives, for gathering candidate pairs.
-struct Prims<'a> {
-    model: &'a Model,
-    owners: &'a [u32],
-    points: &'a [u32],
-    tris: &'a [[u32; 3]],
-    edges: &'a [[u32; 2]],
-}
-
-impl Prims<'_> {
-    /// Replaces `point_tri` and `edge_edge` with the particle–triangle and edge–edge pairs of
-    /// surfaces that collide nearer than `reach` at `x`, found through `bins` (binned at `x`
-    /// with that reach): by particle, then by the particle's cells and triangle; by edge,
-    /// then by the edge's cells and the other edge.
-    fn gather(
-        &self,
-        bins: &Bins,
-        x: &[Vec3],
-        reach: f64,
-        scratch: &mut Vec<Vec<[u32; 2]>>,
-        point_tri: &mut Vec<[u32; 2]>,
-        edge_edge: &mut Vec<[u32; 2]>,
-    ) {
-        let (model, owners) = (self.model, self.owners);
-        // Exact distances at the build: while no particle moves more than half a skin, no
-        // pair farther apart than the thickness plus the skin can come within the thickness.
-        let reach2 = reach * reach;
-        let (tris, tri_box, tri_grid) = (self.tris, &bins.tri_box, &bins.tri_grid);
-        let (edges, edge_box, edge_grid) = (self.edges, &bins.edge_box, &bins.edge_grid);
-        let points = self.points;
-
-        // Particle against triangle: the triangle's low cell is the particle's or one below.
-        par_fill(points.len(), scratch, |i, out| {
-            let p = points[i];
-            let xp = x[p as usize];
-            let c = tri_grid.cell_of(&xp);
-            for d in 0..8 {
-                let cell = [c[0] - (d & 1), c[1] - ((d >> 1) & 1), c[2] - ((d >> 2) & 1)];
-                tri_grid.visit(cell, |t| {
-                    let tri = tris[t as usize];
-                    if !tri.contains(&p)
-                        && inside(&xp, &tri_box[t as usize])
-                        && pair(model, owners, p, tri[0]).is_some()
-                    {
-                        let [a, b, c] = tri.map(|i| x[i as usize]);
-                        let w = point_triangle(&xp, &a, &b, &c);
-                        if (a * w[0] + b * w[1] + c * w[2] - xp).norm_squared() < reach2 {
-                            out.push([p, t]);
-                        }
-                    }
-                });
-            }
-        });
-        point_tri.clear();
-        append(point_tri, scratch);
-
-        // Edge against edge: each pair once, from its lower edge, over the edge's own cell
-        // and the 13 neighbours of one half-space (the other 13 see it from theirs).
-        par_fill(edges.len(), scratch, |e, out| {
-            let e = e as u32;
-            let c = edge_grid.item_cell(e);
-            let ee = edges[e as usize];
-            for d in 13..27 {
-                let cell = [c[0] + d % 3 - 1, c[1] + (d / 3) % 3 - 1, c[2] + d / 9 - 1];
-                let own = d == 13;
-                edge_grid.visit(cell, |f| {
-                    let ef = edges[f as usize];
-                    if (!own || f > e)
-                        && !ef.contains(&ee[0])
-                        && !ef.contains(&ee[1])
-                        && overlap(&edge_box[e as usize], &edge_box[f as usize])
-                        && pair(model, owners, ee[0], ef[0]).is_some()
-                    {
-                        let [a, b] = ee.map(|i| x[i as usize]);
-                        let [c, d] = ef.map(|i| x[i as usize]);
-                        let (s, t) = segment_segment(&a, &b, &c, &d);
-                        if (a + (b - a) * s - c - (d - c) * t).norm_squared() < reach2 {
-                            out.push([e, f]);
-                        }
-                    }
-                });
-            }
-        });
-        edge_edge.clear();
-        append(edge_edge, scratch);
-    }
-}
-
-/// Boxes of triangles and edges grown by a reach, and grids of them.
-#[derive(Clone, Debug, Default)]
-struct Bins {
-    tri_box: Vec<(Vec3, Vec3)>,
-    edge_box: Vec<(Vec3, Vec3)>,
-    tri_grid: Grid,
-    edge_grid: Grid,
-}
-
-impl Bins {
-    /// Bins the boxes of `tris` and `edges` at `x`, grown by `reach` (edges by half), in
-    /// cells at least as large as the reach and every box.
-    fn bin(&mut self, x: &[Vec3], tris: &[[u32; 3]], edges: &[[u32; 2]], reach: f64) {
-        let bounds = |ids: &[u32]| {
-            ids.iter().fold(
-                (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
-                |(lo, hi), &i| (lo.inf(&x[i as usize]), hi.sup(&x[i as usize])),
-            )
-        };
-        self.tri_box.clear();
-        self.tri_box.extend(tris.iter().map(|t| {
-            let (lo, hi) = bounds(t);
-            (lo.add_scalar(-reach), hi.add_scalar(reach))
-        }));
-        self.edge_box.clear();
-        self.edge_box.extend(edges.iter().map(|e| {
-            let (lo, hi) = bounds(e);
-            (lo.add_scalar(-0.5 * reach), hi.add_scalar(0.5 * reach))
-        }));
-        let cell = self
-            .tri_box
-            .iter()
-            .chain(&self.edge_box)
-            .map(|(lo, hi)| (hi - lo).max())
-            .fold(reach, f64::max);
-        self.tri_grid.build(cell, self.tri_box.iter().map(|b| b.0));
-        self.edge_grid
-            .build(cell, self.edge_box.iter().map(|b| b.0));
-    }
-}
-
-/// Chunks of a parallel pass over candidates. Fixed, so that results come out in candidate
-/// order whatever the thread count.
-const CHUNKS: usize = 8;
-/// Fewer candidates than this are not worth a parallel pass.
-const PARALLEL_MIN: usize = 512;
-
-/// Calls `f(i, out)` for every `i < n`, filling `bufs` (one per chunk of consecutive
-/// indices, [`CHUNKS`] of them) in parallel; reading the buffers in order gives what a
-/// sequential pass would have pushed.
-fn par_fill<U: Send>(
-    n: usize,
-    bufs: &mut Vec<Vec<U>>,
-    f: impl Fn(usize, &mut Vec<U>) + Sync + Send,
-) {
-    bufs.resize_with(CHUNKS, Vec::new);
-    for b in bufs.iter_mut() {
-        b.clear();
-    }
-    if n < PARALLEL_MIN {
-        for i in 0..n {
-            f(i, &mut bufs[0]);
-        }
-        return;
-    }
-    let per = n.div_ceil(CHUNKS);
-    bufs.par_iter_mut().enumerate().for_each(|(k, out)| {
-        for i in (k * per).min(n)..((k + 1) * per).min(n) {
-            f(i, out);
-        }
-    });
-}
-
-/// Appends the chunk buffers of [`par_fill`] to `dst` in order.
-fn append<U: Copy>(dst: &mut Vec<U>, bufs: &[Vec<U>]) {
-    for b in bufs {
-        dst.extend_from_slice(b);
-    }
-}
-
-/// The travel sum up to which a pair tested at `x`, with its particles' travel summing to
-/// `moved`, cannot come within its thickness: `moved + d - h` less a margin for rounding
-/// (relative to the distances and travel involved), or `-inf` when it is within it now.
-fn next_budget(s: &Stencil, x: &[Vec3], moved: f64) -> f64 {
-    let d = s.gap(x).norm();
-    let slack = d - s.h - 1e-6 * (d + moved) - 1e-9;
-    if slack > 0.0 {
-        moved + slack
-    } else {
-        f64::NEG_INFINITY
-    }
-}
-
-/// Candidates tested together: a block is skipped whole while no candidate in it can have
-/// used up its budget.
-const BLOCK: usize = 64;
-
-/// A block of candidates: the climb when it was last tested, and the smallest budget left
-/// (budget less the travel sum) among its candidates then.
-#[derive(Clone, Copy, Debug)]
-struct Block {
-    climb: f64,
-    left: f64,
-}
-
-impl Block {
-    const UNTESTED: Self = Self {
-        climb: 0.0,
-        left: f64::NEG_INFINITY,
-    };
-}
-
-/// A candidate list's budgets: one per candidate (see [`ContactState::detect`]), and per
-/// block of [`BLOCK`] candidates when it was last tested and its least budget left.
-#[derive(Clone, Debug, Default)]
-struct Budgets {
-    per_pair: Vec<f64>,
-    blocks: Vec<Block>,
-}
-
-impl Budgets {
-    /// Budgets for a new list of `n` candidates: every one untested.
-    fn reset(&mut self, n: usize) {
-        self.per_pair.clear();
-        self.per_pair.resize(n, f64::NEG_INFINITY);
-        self.blocks.clear();
-        self.blocks.resize(n.div_ceil(BLOCK), Block::UNTESTED);
-    }
-
-    /// [`par_blocks`] over these budgets.
-    fn run<U: Send>(
-        &mut self,
-        bufs: &mut Vec<Vec<U>>,
-        climb: Option<f64>,
-        f: impl Fn(usize, &mut f64, &mut Vec<U>) -> f64 + Sync + Send,
-    ) {
-        par_blocks(bufs, &mut self.per_pair, &mut self.blocks, climb, f);
-    }
-}
-
-/// Calls `f(i, &mut budget[i], out)` for every candidate of a block that may have used up
-/// its budget, in [`CHUNKS`] parallel chunks of whole blocks whose outputs read in order give
-/// what a sequential pass pushes; `f` returns the candidate's budget left. A block is
-/// skipped while four times the climb since its test (a bound on any candidate's travel
-/// sum's growth: four particles, none of whose travel grew by more than the climb) is below
-/// the least budget left in it; with `climb` `None` no block is skipped.
-fn par_blocks<U: Send>(
-    bufs: &mut Vec<Vec<U>>,
-    budgets: &mut [f64],
-    blocks: &mut [Block],
-    climb: Option<f64>,
-    f: impl Fn(usize, &mut f64, &mut Vec<U>) -> f64 + Sync + Send,
-) {
-    // `None`: test every block.
-    let (climb, skip) = (climb.unwrap_or(0.0), climb.is_some());
-    bufs.resize_with(CHUNKS, Vec::new);
-    for b in bufs.iter_mut() {
-        b.clear();
-    }
-    let run = |first: usize, budgets: &mut [f64], blocks: &mut [Block], out: &mut Vec<U>| {
-        for (k, (chunk, block)) in budgets.chunks_mut(BLOCK).zip(blocks).enumerate() {
-            if skip && 4.0 * (climb - block.climb) < block.left {
-                continue;
-            }
-            let start = first + k * BLOCK;
-            let mut left = f64::INFINITY;
-            for (j, budget) in chunk.iter_mut().enumerate() {
-                left = left.min(f(start + j, budget, out));
-            }
-            *block = Block { climb, left };
-        }
-    };
-    let n = budgets.len();
-    if n < PARALLEL_MIN {
-        run(0, budgets, blocks, &mut bufs[0]);
-        return;
-    }
-    let per = blocks.len().div_ceil(CHUNKS);
-    bufs.par_iter_mut()
-        .zip(
-            budgets
-                .par_chunks_mut(per * BLOCK)
-                .zip(blocks.par_chunks_mut(per)),
-        )
-        .enumerate()
-        .for_each(|(k, (out, (budgets, blocks)))| run(k * per * BLOCK, budgets, blocks, out));
-}
-
 /// The closest points of a collider feature and triangle `t` at `x`: the feature's point
 /// and the triangle's barycentric weights; `None` when a cheap bound shows they are farther
 /// apart than `within`.
@@ -844,30 +473,6 @@ fn feature_gap(
     };
     let gap = a * w[0] + b * w[1] + c * w[2] - anchor;
     (gap.norm_squared() < within * within).then_some((anchor, w))
-}
-
-/// Whether `p` lies in the box.
-fn inside(p: &Vec3, (lo, hi): &(Vec3, Vec3)) -> bool {
-    (0..3).all(|k| lo[k] <= p[k] && p[k] <= hi[k])
-}
-
-/// Whether two boxes overlap.
-fn overlap((a0, a1): &(Vec3, Vec3), (b0, b1): &(Vec3, Vec3)) -> bool {
-    (0..3).all(|k| a0[k] <= b1[k] && b0[k] <= a1[k])
-}
-
-/// Whether particles `a` and `b` (both on active surfaces) collide: their surfaces differ
-/// or share self-collision; with the pair's thickness (the larger) and friction (the mean).
-fn pair(model: &Model, surface_of: &[u32], a: u32, b: u32) -> Option<(f64, f64)> {
-    let (sa, sb) = (surface_of[a as usize], surface_of[b as usize]);
-    let (s, t) = (&model.surfaces[sa as usize], &model.surfaces[sb as usize]);
-    if sa == sb && !s.self_collision {
-        return None;
-    }
-    Some((
-        s.thickness.max(t.thickness),
-        0.5 * (s.friction + t.friction),
-    ))
 }
 
 /// Runs the contact phase after an integrator step: `x0` are the step's start positions.
