@@ -385,13 +385,22 @@ pub fn drape(args: &DrapeArgs) -> Result<ExitCode> {
             .iter()
             .map(|c| format!("{c} ×{}", s.nodes.iter().filter(|n| *n == c).count()))
             .collect();
+        let how_often = |c: usize| s.nodes.iter().filter(|&&n| n == c).count();
+        let tied = counts
+            .iter()
+            .filter(|&&c| how_often(c) == how_often(s.mode))
+            .count();
+        // A tie has no most frequent count: say so rather than pick one.
+        let mode = if tied > 1 {
+            format!("{tied} counts tie, none most often")
+        } else {
+            format!("most often {} nodes, DC there {:.3}", s.mode, s.dc_at_mode)
+        };
         println!(
-            "DC {:.3} ± {:.3} (mean ± sd); nodes {}; most often {} nodes, DC there {:.3}",
+            "DC {:.3} ± {:.3} (mean ± sd); nodes {}; {mode}",
             s.dc_mean,
             s.dc_sd,
             spread.join(", "),
-            s.mode,
-            s.dc_at_mode
         );
     }
     large_step_note(&meter);
