@@ -65,6 +65,13 @@ kd = 0.005
         .unwrap()
 }
 
+/// The ground, with friction.
+const GROUND: &str = r#"
+[[collider]]
+shape = { kind = "ground", height = 0.0 }
+response = { kind = "restitution", cr = 0.0, friction = 0.5 }
+"#;
+
 /// The highest point of the cloth in the last frame, and its lowest.
 fn heights(frame: &crate::contact::Frame) -> (f64, f64) {
     let ys = frame.cloth.iter().flat_map(|(t, _)| t.iter().map(|p| p.y));
@@ -100,10 +107,7 @@ fn cup() -> std::path::PathBuf {
 fn cloth_pushed_into_a_cup_by_a_ball_never_crosses() {
     let cup = cup();
     let colliders = format!(
-        r#"
-[[collider]]
-shape = {{ kind = "ground", height = 0.0 }}
-response = {{ kind = "restitution", cr = 0.0, friction = 0.5 }}
+        r#"{GROUND}
 [[collider]]
 shape = {{ kind = "mesh", path = "{}" }}
 response = {{ kind = "restitution", cr = 0.0, friction = 0.3 }}
@@ -131,12 +135,7 @@ fn a_sheet_folded_tight_on_itself_never_crosses() {
 pins = { box = [[-0.01, -0.01, -0.01], [0.41, 0.01, 0.01]] }
 pin_motion = { keys = [{ t = 0.0, translate = [0.0, 0.0, 0.0] }, { t = 0.8, translate = [0.0, 0.12, 0.2] }, { t = 1.6, translate = [0.0, 0.012, 0.39] }] }
 "#;
-    let ground = r#"
-[[collider]]
-shape = { kind = "ground", height = 0.0 }
-response = { kind = "restitution", cr = 0.0, friction = 0.5 }
-"#;
-    let scene = sheet(24, 0.4, [0.0, 0.0055, 0.0], 2.5, (pins, ground));
+    let scene = sheet(24, 0.4, [0.0, 0.0055, 0.0], 2.5, (pins, GROUND));
     let last = assert_scene_never_crosses(scene, "crease-fold");
     // Folded: two layers, the top one resting on the bottom one.
     let (hi, _) = heights(&last);
@@ -151,13 +150,8 @@ fn a_hanging_sheet_twisted_on_itself_never_crosses() {
 pins = { box = [[-0.01, -0.01, -0.01], [0.41, 0.01, 0.01]] }
 pin_motion = { keys = [{ t = 0.0, translate = [0.0, 0.0, 0.0] }, { t = 0.66, translate = [0.0, 0.0, 0.0], rotate = [0.0, 180.0, 0.0] }, { t = 1.33, translate = [0.0, 0.0, 0.0], rotate = [0.0, 360.0, 0.0] }, { t = 2.0, translate = [0.0, 0.0, 0.0], rotate = [0.0, 540.0, 0.0] }] }
 "#;
-    let ground = r#"
-[[collider]]
-shape = { kind = "ground", height = 0.0 }
-response = { kind = "restitution", cr = 0.0, friction = 0.5 }
-"#;
     // Hung in the x-y plane: turned 90° about x, its first row on top.
     let pins = format!("rotate = [90.0, 0.0, 0.0]\n{pins}");
-    let scene = sheet(24, 0.4, [-0.2, 1.0, 0.0], 2.5, (&pins, ground));
+    let scene = sheet(24, 0.4, [-0.2, 1.0, 0.0], 2.5, (&pins, GROUND));
     assert_scene_never_crosses(scene, "crease-twist");
 }
