@@ -15,7 +15,10 @@
 //!
 //! Distances are searched only up to a reach (`R_s`, `R_c`); a pair farther than the reach
 //! bounds by the reach, which is enough for the same argument. The bound holds whatever the
-//! step size: the integrator can fail to converge, never cross.
+//! step size: the integrator can fail to converge, never cross. The pairs of one surface
+//! that its own springs hold apart (`exclusion.rs`: within the reach of each other at rest,
+//! and along the surface) are not searched and bound nothing: the argument does not cover
+//! them, and a crease that brings such a pair within a thickness can cross.
 
 mod colliders;
 
