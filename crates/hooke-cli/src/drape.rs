@@ -381,11 +381,11 @@ pub fn drape(args: &DrapeArgs) -> Result<ExitCode> {
         let mut counts: Vec<usize> = s.nodes.clone();
         counts.sort_unstable();
         counts.dedup();
+        let how_often = |c: usize| s.nodes.iter().filter(|&&n| n == c).count();
         let spread: Vec<String> = counts
             .iter()
-            .map(|c| format!("{c} ×{}", s.nodes.iter().filter(|n| *n == c).count()))
+            .map(|&c| format!("{c} ×{}", how_often(c)))
             .collect();
-        let how_often = |c: usize| s.nodes.iter().filter(|&&n| n == c).count();
         let tied = counts
             .iter()
             .filter(|&&c| how_often(c) == how_often(s.mode))

@@ -515,12 +515,12 @@ pub struct Fit {
 }
 
 impl Fit {
-    /// Whether the target lies outside what the fit's range of `B` gives: the bracket never
-    /// left one end of it ([`FIT_RANGE`]) and the last DC is more than a jump's height
-    /// (0.02) from the target.
+    /// Whether the target lies outside what the fit's range of `B` gives: one end of the
+    /// bracket never moved from the range's ([`FIT_RANGE`]: every DC tried was on one side
+    /// of the target) and the last DC is more than a jump's height (0.02) from the target.
     pub fn outside(&self, target: f64) -> bool {
         let at_end = |b: f64, end: f64| (b / end - 1.0).abs() < 1e-9;
-        (at_end(self.bracket.0, FIT_RANGE.1) || at_end(self.bracket.1, FIT_RANGE.0))
+        (at_end(self.bracket.0, FIT_RANGE.0) || at_end(self.bracket.1, FIT_RANGE.1))
             && (self.dc - target).abs() > 0.02
     }
 }
@@ -572,6 +572,24 @@ pub fn fit_bending(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A target above (or below) every DC the range of B gives is said to lie outside
+    /// it; one inside is not.
+    #[test]
+    fn a_target_no_rigidity_reaches_is_outside_the_fit() {
+        let dc = |b: f64| 0.4 + 0.1 * (b / 1e-5).ln().tanh();
+        let base = Material {
+            density: 0.15,
+            stretch: 1000.0,
+            shear: 50.0,
+            bending: 0.0,
+            damping: 1e-5,
+        };
+        for (target, outside) in [(0.9, true), (0.2, true), (0.45, false)] {
+            let fit = fit_bending(target, &base, 0.02, &mut |m| Ok(dc(m.bending))).unwrap();
+            assert_eq!(fit.outside(target), outside, "{target}: {fit:?}");
+        }
+    }
 
     /// On a DC that rises smoothly with B the bisection finds the rigidity that gives
     /// the target within its tolerance, in about log₂(ln 10⁴ / ln 1.02) ≈ 9 tries.
