@@ -204,9 +204,12 @@ impl Exclusion {
         }
         let adj = Adjacency::new(topo, rest);
         let path = PATH * radius;
+        // Each worker's search marks are as long as the mesh: at most 64 sets of them, not
+        // one per split of a large mesh.
+        let per_split = |len: usize| len.div_ceil(64).max(256);
         let triangles: Vec<Vec<u32>> = (0..n as u32)
             .into_par_iter()
-            .with_min_len(256)
+            .with_min_len(per_split(n))
             .map_init(
                 || Paths::new(n, topo.triangles.len()),
                 |paths, v| {
@@ -237,7 +240,7 @@ impl Exclusion {
             .collect();
         let edges: Vec<Vec<u32>> = (0..topo.edges.len())
             .into_par_iter()
-            .with_min_len(256)
+            .with_min_len(per_split(topo.edges.len()))
             .map_init(
                 || Paths::new(n, topo.edges.len()),
                 |paths, e| {
