@@ -41,8 +41,10 @@ pub(crate) fn mesh_file_len(path: &str, base: &Path) -> u64 {
     }
 }
 
-/// Where a mesh path points: a built-in mesh or a file.
-pub(crate) fn mesh_text(path: &str, base: &Path) -> Result<(String, PathBuf), MeshError> {
+/// The text of the mesh a scene's `path` names, and where it was found: a built-in mesh
+/// (`builtin:NAME`) or a file relative to `base`, read as every text input is
+/// ([`hooke_core::text::read_text`]).
+pub fn mesh_text(path: &str, base: &Path) -> Result<(String, PathBuf), MeshError> {
     if let Some(name) = path.strip_prefix("builtin:") {
         return match BUILTIN_MESHES.iter().find(|(n, _)| *n == name) {
             Some((_, text)) => Ok((text(), PathBuf::from(path))),

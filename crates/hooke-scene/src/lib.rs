@@ -46,7 +46,7 @@ pub mod workload;
 pub mod world;
 
 pub use body::mesh::solid::enclosed_volume;
-pub use colliders::BUILTIN_MESHES;
+pub use colliders::{BUILTIN_MESHES, mesh_text};
 pub use error::BuildError;
 pub use limits::{MAX_PARTICLES, MAX_STEPS};
 pub use overrides::{Overrides, TableOverride};

@@ -211,31 +211,13 @@ response = {{ kind = "restitution", cr = 0.0, friction = {friction:e} }}
         let Some(path) = &self.mesh else {
             return Ok(());
         };
-        let builtin = path
-            .to_str()
-            .and_then(|p| p.strip_prefix("builtin:"))
-            .map(|name| {
-                hooke_scene::BUILTIN_MESHES
-                    .iter()
-                    .find(|(n, _)| *n == name)
-                    .map(|(_, text)| text())
-                    .ok_or_else(|| {
-                        let names = hooke_scene::BUILTIN_MESHES.map(|m| m.0);
-                        crate::Error::input(format!(
-                            "--mesh {}: no such built-in mesh; they are {}",
-                            path.display(),
-                            names.join(", ")
-                        ))
-                    })
-            })
-            .transpose()?;
-        let mesh = match builtin {
-            Some(text) => {
-                hooke_collide::PolygonMesh::parse(&text, path, hooke_scene::MAX_PARTICLES)
-            }
-            None => hooke_collide::PolygonMesh::load(path, hooke_scene::MAX_PARTICLES),
-        }
-        .map_err(|e| crate::Error::input(e.to_string()))?;
+        let limit = hooke_scene::MAX_PARTICLES;
+        let mesh = match path.to_str().filter(|p| p.starts_with("builtin:")) {
+            // A mesh shipped with Hooke, found as a scene finds it.
+            Some(name) => hooke_scene::mesh_text(name, std::path::Path::new(""))
+                .and_then(|(text, at)| hooke_collide::PolygonMesh::parse(&text, &at, limit)),
+            None => hooke_collide::PolygonMesh::load(path, limit),
+        }?;
         let used: std::collections::BTreeSet<u32> = mesh
             .faces
             .iter()
