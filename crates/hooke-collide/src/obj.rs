@@ -2,6 +2,7 @@
 
 use hooke_core::{SANE_BOUND, Vec3};
 use nalgebra::Rotation3;
+use std::borrow::Cow;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
@@ -139,12 +140,15 @@ pub fn parse_obj(
     placement: &Placement,
 ) -> Result<Vec<MeshPart>, MeshError> {
     // tobj parses NaN happily and reports no lines, so vertices and faces are checked here
-    // first, each error with its line.
-    let vertices = text
-        .lines()
-        .filter(|l| l.split_whitespace().next() == Some("v"))
+    // first, each error with its line; nor does it join continued lines, so it reads the
+    // statements joined.
+    let statements = statements(text);
+    let vertices = statements
+        .iter()
+        .filter(|(_, l)| l.split_whitespace().next() == Some("v"))
         .count();
-    for (n, line) in text.lines().enumerate() {
+    for (n, line) in &statements {
+        let (n, line) = (*n, line.as_ref());
         let mut words = line.split_whitespace();
         let bad = |reason: String| MeshError::Line {
             path: path.to_path_buf(),
@@ -189,13 +193,15 @@ pub fn parse_obj(
         single_index: true,
         ..Default::default()
     };
+    let text = joined(text, &statements);
     let (models, _materials) =
-        tobj::load_obj_buf(&mut Cursor::new(text), &options, |_| Ok(Default::default())).map_err(
-            |e| MeshError::Obj {
-                path: path.to_path_buf(),
-                reason: e.to_string(),
-            },
-        )?;
+        tobj::load_obj_buf(&mut Cursor::new(text.as_ref()), &options, |_| {
+            Ok(Default::default())
+        })
+        .map_err(|e| MeshError::Obj {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
     let parts: Vec<MeshPart> = models
         .into_iter()
         .filter(|m| !m.mesh.indices.is_empty())
@@ -292,6 +298,46 @@ pub(crate) fn coordinates<'a>(
             Err(_) => Err(bad(format!("'{}' is not a number", excerpt(w)))),
         })
         .collect()
+}
+
+/// The statements of OBJ text, each with its first line's 0-based index: a line ending in a
+/// backslash (the format's line continuation) is joined to the next with a space.
+pub(crate) fn statements(text: &str) -> Vec<(usize, Cow<'_, str>)> {
+    let mut out: Vec<(usize, Cow<'_, str>)> = Vec::new();
+    let mut open = false;
+    for (n, line) in text.lines().enumerate() {
+        let (body, continues) = match line.trim_end().strip_suffix('\\') {
+            Some(body) => (body, true),
+            None => (line, false),
+        };
+        match out.last_mut() {
+            Some((_, joined)) if open => {
+                let joined = joined.to_mut();
+                joined.push(' ');
+                joined.push_str(body);
+            }
+            _ if continues => out.push((n, Cow::Owned(body.to_string()))),
+            _ => out.push((n, Cow::Borrowed(line))),
+        }
+        open = continues;
+    }
+    out
+}
+
+/// `text` with its continued lines joined, as [`statements`] read it (`text` itself when
+/// none continues): what tobj, which does not join them, is given.
+pub(crate) fn joined<'a>(text: &'a str, statements: &[(usize, Cow<'_, str>)]) -> Cow<'a, str> {
+    if statements.iter().any(|(_, l)| matches!(l, Cow::Owned(_))) {
+        Cow::Owned(
+            statements
+                .iter()
+                .map(|(_, l)| l.as_ref())
+                .collect::<Vec<_>>()
+                .join("\n"),
+        )
+    } else {
+        Cow::Borrowed(text)
+    }
 }
 
 /// Characters of a line echoed in an error.

@@ -7,7 +7,7 @@
 //! indices the faces name, which a body must keep to hand its vertices back in the user's
 //! order, are read from the same lines as the checks that name a line in their errors.
 
-use crate::obj::{MeshError, coordinates, excerpt, resolve};
+use crate::obj::{MeshError, coordinates, excerpt, joined, resolve, statements};
 use hooke_core::Vec3;
 use std::io::Cursor;
 use std::path::Path;
@@ -61,7 +61,9 @@ impl PolygonMesh {
         let mut mesh = PolygonMesh::default();
         let mut current: Vec<u32> = Vec::new();
         let mut object: Option<u32> = None;
-        for (n, line) in text.lines().enumerate() {
+        let statements = statements(text);
+        for (n, line) in &statements {
+            let (n, line) = (*n, line.as_ref());
             let bad = |reason: String| MeshError::Line {
                 path: path.to_path_buf(),
                 line: n + 1,
@@ -158,12 +160,15 @@ impl PolygonMesh {
             single_index: false,
             ..Default::default()
         };
-        let (models, _) =
-            tobj::load_obj_buf(&mut Cursor::new(text), &options, |_| Ok(Default::default()))
-                .map_err(|e| MeshError::Obj {
-                    path: path.to_path_buf(),
-                    reason: e.to_string(),
-                })?;
+        let (models, _) = tobj::load_obj_buf(
+            &mut Cursor::new(joined(text, &statements).as_ref()),
+            &options,
+            |_| Ok(Default::default()),
+        )
+        .map_err(|e| MeshError::Obj {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
         let faces: usize = models
             .iter()
             .map(|m| {
@@ -222,6 +227,29 @@ mod tests {
         assert_eq!(m.groups, vec!["hem".to_string(), "body".to_string()]);
         assert_eq!(m.faces[0].groups, vec![0]);
         assert_eq!(m.faces[1].line, 14);
+    }
+
+    /// A line ending in a backslash continues on the next (the OBJ format's continuation,
+    /// CRLF endings too): the face is one quad, and a bad corner after it names the line
+    /// its statement starts on.
+    #[test]
+    fn a_continued_line_is_one_statement() {
+        let m = parse(
+            "v 0 0 0\r\nv 1 0 0\r\nv 1 0 1 \\\r\n\r\nv 0 0 1\r\nf 1 2 \\\r\n 3 4\r\nf 1 2 3\r\n",
+        )
+        .unwrap();
+        assert_eq!(
+            m.positions.len(),
+            4,
+            "the empty line continues the third vertex"
+        );
+        assert_eq!(m.faces[0].corners, vec![0, 1, 2, 3]);
+        assert_eq!(m.faces[1].line, 8);
+        let m = parse("v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 2 \\\n 3 4\nf 1 2 3\n").unwrap();
+        assert_eq!(m.faces[0].corners, vec![0, 1, 2, 3]);
+        assert_eq!(m.faces[1].line, 7);
+        let e = parse("v 0 0 0\nv 1 0 0\nv 1 0 1\nf 1 2 \\\n 9\n").unwrap_err();
+        assert!(e.contains("m.obj:4") && e.contains("'9'"), "{e}");
     }
 
     /// Bad lines are refused with their line number.
