@@ -360,7 +360,8 @@ impl Pins {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PinRegion {
-    /// Opposite corners of a box.
+    /// A box by its lowest and highest corners (each coordinate of the first at most the
+    /// second's).
     #[serde(rename = "box", default, skip_serializing_if = "Option::is_none")]
     pub aabb: Option<[[Finite; 3]; 2]>,
     /// A ball.
@@ -377,8 +378,9 @@ pub struct PinRegion {
 pub struct PinSphere {
     /// Its centre.
     pub center: [Finite; 3],
-    /// Its radius.
-    pub radius: Positive,
+    /// Its radius, metres: above zero (checked when the body is built, so that the error
+    /// names the key rather than the whole `pins` table).
+    pub radius: Finite,
 }
 
 fn origin() -> [Finite; 3] {

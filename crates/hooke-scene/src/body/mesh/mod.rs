@@ -336,16 +336,37 @@ pub(crate) fn region_pins(
         ));
     }
     let picked: Vec<usize> = if let Some([a, b]) = &region.aabb {
-        let (a, b) = (crate::spec::vec3(a), crate::spec::vec3(b));
-        let (lo, hi) = (a.inf(&b), a.sup(&b));
+        let (lo, hi) = (crate::spec::vec3(a), crate::spec::vec3(b));
+        // Corners given the wrong way round are most likely a typo in one of them: a box
+        // made of them anyway may hold far more than was meant.
+        if let Some(d) = (0..3).find(|&d| lo[d] > hi[d]) {
+            let axis = ["x", "y", "z"][d];
+            return Err(invalid(
+                format!("{key}.pins.box"),
+                format!(
+                    "the first corner is the lowest and the second the highest, but {axis} \
+                     goes from {} down to {}: swap them",
+                    hooke_core::Num(lo[d]),
+                    hooke_core::Num(hi[d])
+                ),
+            ));
+        }
         (0..at.len())
             .filter(|&p| (0..3).all(|d| at[p][d] >= lo[d] && at[p][d] <= hi[d]))
             .collect()
     } else if let Some(s) = &region.sphere {
+        let r = s.radius.get();
+        if r <= 0.0 {
+            return Err(invalid(
+                format!("{key}.pins.sphere.radius"),
+                format!(
+                    "a ball of pins needs a radius above zero, found {}",
+                    hooke_core::Num(r)
+                ),
+            ));
+        }
         let c = crate::spec::vec3(&s.center);
-        (0..at.len())
-            .filter(|&p| (at[p] - c).norm() <= s.radius.get())
-            .collect()
+        (0..at.len()).filter(|&p| (at[p] - c).norm() <= r).collect()
     } else {
         let name = region.group.as_deref().unwrap_or_default();
         let Some(sheet) = sheet else {

@@ -76,6 +76,27 @@ pub(crate) fn sheet(
         }
         kept.push((corners, face.line, face.groups.clone()));
     }
+    if let (true, Some(d)) = (kept.is_empty(), weld) {
+        let edges = mesh.faces.iter().flat_map(|f| {
+            let c = &f.corners;
+            (0..c.len()).map(move |k| (c[k], c[(k + 1) % c.len()]))
+        });
+        let shortest = edges
+            .map(|(a, b)| (mesh.positions[a as usize] - mesh.positions[b as usize]).norm())
+            .filter(|&l| l > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        if shortest <= d {
+            return Err(invalid(
+                format!("{key}.shape.weld"),
+                format!(
+                    "{shown}: weld = {} m merges the corners of every face (the file's \
+                     shortest edge is {} m): make weld smaller than that",
+                    Num(d),
+                    Num(shortest)
+                ),
+            ));
+        }
+    }
     if kept.is_empty() {
         return Err(invalid(
             format!("{key}.shape.path"),
