@@ -34,7 +34,7 @@ pub fn render(args: &RenderArgs) -> Result<ExitCode> {
         eprintln!(
             "{}: t = {} s is {steps} steps of {} s (Ctrl-C stops)",
             scene.spec.name,
-            Num(steps as f64 * dt),
+            hooke_core::Approx(steps as f64 * dt),
             Num(dt)
         );
     }
@@ -45,7 +45,7 @@ pub fn render(args: &RenderArgs) -> Result<ExitCode> {
     eprintln!(
         "{}: t = {} s -> {}",
         scene.spec.name,
-        Num(scene.simulation.time()),
+        hooke_core::Approx(scene.simulation.time()),
         args.output.display()
     );
     Ok(ExitCode::SUCCESS)

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 /// The run was interrupted: carried as an error so that every caller stops the same way.
 #[derive(Debug, thiserror::Error)]
-#[error("interrupted at step {step} (t = {} s)", hooke_core::Num(*.time))]
+#[error("interrupted at step {step} (t = {} s)", hooke_core::Approx(*.time))]
 pub struct Interrupted {
     /// Steps completed.
     pub step: u64,
@@ -342,6 +342,17 @@ pub(crate) use {bail_input, bail_output};
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The time a run stopped at is said to four digits, not as the step count times a
+    /// step that no binary fraction holds (`0.31666666666666665`).
+    #[test]
+    fn an_interruption_says_its_time_without_rounding_noise() {
+        let e = Interrupted {
+            step: 19,
+            time: 19.0 * (1.0 / 60.0),
+        };
+        assert_eq!(e.to_string(), "interrupted at step 19 (t = 0.3167 s)");
+    }
 
     #[test]
     fn context_goes_in_front_and_keeps_the_variant() {
