@@ -75,6 +75,8 @@ struct Bar {
     started: Instant,
     shown: Cell<bool>,
     left: TimeLeft,
+    /// Whether the run may end before its last step (then its time left is at most).
+    until: bool,
 }
 
 impl Progress for Bar {
@@ -83,7 +85,9 @@ impl Progress for Bar {
         if let Some(total) = self.bar.length()
             && let Some(left) = self.left.after(Instant::now(), done, total)
         {
-            self.bar.set_message(format!("about {} left", human(left)));
+            let about = if self.until { "at most" } else { "about" };
+            self.bar
+                .set_message(format!("{about} {} left", human(left)));
         }
         if !self.shown.get() && self.started.elapsed() >= SHOW_AFTER {
             self.shown.set(true);
@@ -104,6 +108,8 @@ struct Lines {
     started: Instant,
     last: Cell<Instant>,
     left: TimeLeft,
+    /// Whether the run may end before its last step.
+    until: bool,
 }
 
 impl Progress for Lines {
@@ -116,9 +122,14 @@ impl Progress for Lines {
         self.last.set(now);
         let elapsed = now.duration_since(self.started).as_secs_f64();
         let share = done as f64 / self.steps.max(1) as f64;
-        let left = left.map_or_else(String::new, |s| format!(", about {} left", human(s)));
+        let (of, about) = if self.until {
+            ("at most ", "at most")
+        } else {
+            ("", "about")
+        };
+        let left = left.map_or_else(String::new, |s| format!(", {about} {} left", human(s)));
         eprintln!(
-            "{}: step {done} of {} ({:.0} %), {elapsed:.0} s elapsed{left}",
+            "{}: step {done} of {of}{} ({:.0} %), {elapsed:.0} s elapsed{left}",
             self.scene,
             self.steps,
             100.0 * share
@@ -126,8 +137,9 @@ impl Progress for Lines {
     }
 }
 
-impl Reporter for Bars {
-    fn run(&self, scene: &str, steps: u64) -> Box<dyn Progress> {
+impl Bars {
+    /// A run's progress: `until`, it may end before its last step.
+    fn progress(scene: &str, steps: u64, until: bool) -> Box<dyn Progress> {
         if !std::io::stderr().is_terminal() {
             let now = Instant::now();
             return Box::new(Lines {
@@ -137,15 +149,19 @@ impl Reporter for Bars {
                 started: now,
                 last: Cell::new(now),
                 left: TimeLeft::default(),
+                until,
             });
         }
         let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::hidden());
+        let template = if until {
+            "{prefix} [{bar:40}] {pos}/at most {len} steps, {elapsed} elapsed, {msg}"
+        } else {
+            "{prefix} [{bar:40}] {pos}/{len} steps, {elapsed} elapsed, {msg}"
+        };
         bar.set_style(
-            ProgressStyle::with_template(
-                "{prefix} [{bar:40}] {pos}/{len} steps, {elapsed} elapsed, {msg}",
-            )
-            .expect("valid template")
-            .progress_chars("=> "),
+            ProgressStyle::with_template(template)
+                .expect("valid template")
+                .progress_chars("=> "),
         );
         bar.set_prefix(scene.to_string());
         Box::new(Bar {
@@ -153,7 +169,18 @@ impl Reporter for Bars {
             started: Instant::now(),
             shown: Cell::new(false),
             left: TimeLeft::default(),
+            until,
         })
+    }
+}
+
+impl Reporter for Bars {
+    fn run(&self, scene: &str, steps: u64) -> Box<dyn Progress> {
+        Self::progress(scene, steps, false)
+    }
+
+    fn run_until(&self, scene: &str, steps: u64) -> Box<dyn Progress> {
+        Self::progress(scene, steps, true)
     }
 
     fn build(&self, what: &str) -> Box<dyn Progress> {
@@ -164,6 +191,7 @@ impl Reporter for Bars {
                 started: Instant::now(),
                 shown: Cell::new(true),
                 left: TimeLeft::default(),
+                until: false,
             });
         }
         let bar = ProgressBar::new_spinner();
@@ -174,6 +202,7 @@ impl Reporter for Bars {
             started: Instant::now(),
             shown: Cell::new(true),
             left: TimeLeft::default(),
+            until: false,
         })
     }
 }

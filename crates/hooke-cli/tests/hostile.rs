@@ -253,6 +253,26 @@ fn a_long_run_into_a_log_says_how_far_it_got() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A drape repeat stops when the specimen settles, so its progress counts to `--longest`
+/// as a most, not as what is left (issue 71).
+#[test]
+fn a_drapes_progress_says_its_time_left_is_at_most() {
+    let dir = scratch("drape-progress");
+    let out = hooke_in(&dir)
+        .args(["drape", "silk", "--repeats", "1", "--longest", "0.02"])
+        .env("HOOKE_PROGRESS_SECONDS", "0")
+        .output()
+        .unwrap();
+    let said = stderr(&out);
+    assert!(
+        said.contains("drape silk, repeat 1 of 1: step 1 of at most ")
+            && said.contains(" s elapsed, at most ")
+            && !said.contains("about"),
+        "{said}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn a_new_step_keeps_the_frame_interval_and_messages_carry_no_float_noise() {
     let dir = scratch("every");

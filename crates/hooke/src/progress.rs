@@ -9,6 +9,12 @@ use std::sync::OnceLock;
 pub trait Reporter: Send + Sync {
     /// A run of `steps` steps of the scene `scene` begins.
     fn run(&self, scene: &str, steps: u64) -> Box<dyn Progress>;
+    /// A run of at most `steps` steps begins, which ends sooner when what it waits for
+    /// happens (a drape that settles): its time left is an upper bound. The default shows
+    /// it as [`Reporter::run`] does.
+    fn run_until(&self, scene: &str, steps: u64) -> Box<dyn Progress> {
+        self.run(scene, steps)
+    }
     /// A build that takes a while begins; `what` says what is built and how large it is.
     fn build(&self, what: &str) -> Box<dyn Progress>;
     /// A run found something it promised not to do (a surface through a collider, a

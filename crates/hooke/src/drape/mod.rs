@@ -295,7 +295,7 @@ response = {{ kind = "restitution", cr = 0.0, friction = {friction:e} }}
         let mut quiet = 0u64;
         let mut settled = false;
         let bar: Box<dyn crate::progress::Progress> = match label {
-            Some(label) => crate::progress::reporter().run(label, scene.steps),
+            Some(label) => crate::progress::reporter().run_until(label, scene.steps),
             None => Box::new(crate::progress::Hidden),
         };
         for _ in 0..scene.steps {
