@@ -126,6 +126,30 @@ fn render_and_demo_stop_on_interrupt_with_status_130() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// One Ctrl-C ends a command at a stage that asks for none: `check` of a million-particle
+/// cloth, interrupted while it builds, exits with 130 and says so (it once built on, and
+/// a second and a third were needed).
+#[test]
+fn one_interrupt_ends_a_build_and_a_check() {
+    let dir = scratch("build-int");
+    std::fs::write(
+        dir.join("big.toml"),
+        "name = \"big\"\n[simulation]\nintegrator = \"symplectic\"\ndt = 0.0001\n\
+         duration = 1.0\nevery = 100\n[[body]]\nname = \"cloth\"\nmass = 1e-6\n\
+         [body.shape]\nkind = \"grid\"\nsize = [1000, 1000]\nspacing = 0.001\n\
+         [body.springs.structural]\nks = 300.0\nkd = 0.02\n",
+    )
+    .unwrap();
+    let watched = Watched::spawn(&["check", "big.toml"], &dir);
+    watched.wait_to_say("this takes a while");
+    interrupt(&watched.child);
+    let (status, said) = watched.finish();
+    assert_eq!(status.code(), Some(130), "{said}");
+    assert!(said.trim_end().ends_with("interrupted"), "{said}");
+    assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Output paths that cannot take the file are refused before a (here endless) run starts,
 /// and no temporary file appears, neither beside the target nor in its parent.
 #[test]

@@ -137,6 +137,7 @@ pub fn steps_to(scene: &Scene, at: Option<f64>) -> Result<u64> {
 
 /// Steps `n` times, one at a time so that an interrupt is answered within a step.
 fn steps(scene: &mut Scene, n: u64, bar: &dyn Progress) -> Result<()> {
+    let _polling = interrupt::Polling::start();
     for _ in 0..n {
         interrupt::check(&scene.simulation)?;
         let stepped = scene.simulation.step();
@@ -190,6 +191,7 @@ pub fn advance(scene: &mut Scene, n: u64) -> Result<()> {
 /// ```
 pub fn catch_up(scene: &mut Scene, mut owed: f64, budget: Duration) -> Result<f64> {
     let (dt, started) = (scene.simulation.dt(), Instant::now());
+    let _polling = interrupt::Polling::start();
     while owed >= dt {
         interrupt::check(&scene.simulation)?;
         let stepped = scene.simulation.step();

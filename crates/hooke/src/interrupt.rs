@@ -5,10 +5,43 @@
 //! A second interrupt changes nothing (tools such as `timeout` and impatient users send
 //! two; the run is already stopping and its files must not be lost). A third forces the
 //! exit at once and removes the unfinished temporary files, for a run that does not respond.
+//!
+//! Outside a run nothing asks whether an interrupt came (reading a file, building a scene,
+//! `hooke check`'s estimates): an interrupt that nothing has asked about within
+//! [`ANSWER_WITHIN`], while no run's loop is under way to ask at its next step, ends the
+//! process as the third does, so one Ctrl-C ends any command at any stage. No output is
+//! written before a run starts, so nothing whole is lost.
 
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::time::Duration;
 
 static INTERRUPTS: AtomicU32 = AtomicU32::new(0);
+
+/// Whether a poll ([`requested`]) has seen an interrupt: a run is stopping in order.
+static ANSWERED: AtomicBool = AtomicBool::new(false);
+
+/// How long an interrupt may go unseen by any poll before the process ends at once.
+pub const ANSWER_WITHIN: Duration = Duration::from_millis(500);
+
+/// Runs' loops under way, each asking between its steps: a step may take longer than
+/// [`ANSWER_WITHIN`] (a large implicit step), and its run still ends in order after it.
+static LOOPS: AtomicU32 = AtomicU32::new(0);
+
+/// A run's loop that asks for interrupts between its steps, while it lives.
+pub(crate) struct Polling;
+
+impl Polling {
+    pub(crate) fn start() -> Self {
+        LOOPS.fetch_add(1, Ordering::SeqCst);
+        Polling
+    }
+}
+
+impl Drop for Polling {
+    fn drop(&mut self) {
+        LOOPS.fetch_sub(1, Ordering::SeqCst);
+    }
+}
 
 /// The exit status of an interrupted run.
 pub const EXIT_INTERRUPTED: u8 = 130;
@@ -22,7 +55,17 @@ pub use crate::error::Interrupted;
 pub fn install() {
     let result = ctrlc::set_handler(|| {
         let count = INTERRUPTS.fetch_add(1, Ordering::SeqCst) + 1;
-        if count == 2 {
+        if count == 1 {
+            // The handler runs on a thread of its own: it may wait for the answer there.
+            std::thread::spawn(|| {
+                std::thread::sleep(ANSWER_WITHIN);
+                if !ANSWERED.load(Ordering::SeqCst) && LOOPS.load(Ordering::SeqCst) == 0 {
+                    crate::output::remove_pending();
+                    eprintln!("interrupted");
+                    std::process::exit(EXIT_INTERRUPTED as i32);
+                }
+            });
+        } else if count == 2 {
             eprintln!(
                 "stopping at the last complete frame; interrupt once more to abandon the files"
             );
@@ -39,9 +82,14 @@ pub fn install() {
     }
 }
 
-/// Whether an interrupt arrived.
+/// Whether an interrupt arrived. A caller that sees one stops in order, so the process is
+/// then left to do so (see the module's documentation).
 pub fn requested() -> bool {
-    INTERRUPTS.load(Ordering::Relaxed) > 0
+    let asked = INTERRUPTS.load(Ordering::Relaxed) > 0;
+    if asked {
+        ANSWERED.store(true, Ordering::SeqCst);
+    }
+    asked
 }
 
 /// Between two steps of `simulation`: an [`Interrupted`] error saying where it stopped, if

@@ -298,6 +298,7 @@ response = {{ kind = "restitution", cr = 0.0, friction = {friction:e} }}
             Some(label) => crate::progress::reporter().run_until(label, scene.steps),
             None => Box::new(crate::progress::Hidden),
         };
+        let _polling = crate::interrupt::Polling::start();
         for _ in 0..scene.steps {
             crate::interrupt::check(&scene.simulation)?;
             scene.simulation.advance(1).context("the drape test")?;
