@@ -90,15 +90,10 @@ fn material(args: &DrapeArgs) -> Result<(String, Material)> {
                     PRESETS.map(|p| p.name).join(", ")
                 ))
             })?;
-            #[derive(serde::Deserialize)]
-            #[serde(deny_unknown_fields)]
-            struct File {
-                material: hooke_scene::spec::MaterialSpec,
-            }
-            let file: File =
-                toml::from_str(&text).map_err(|e| anyhow!(format!("{}: {e}", path.display())))?;
+            let spec =
+                hooke_scene::material::parse_material_file(&text, &path).map_err(|e| anyhow!(e))?;
             name = path.display().to_string();
-            base = Some(file.material);
+            base = Some(spec);
         }
     }
     let mut spec = base.unwrap_or_default();

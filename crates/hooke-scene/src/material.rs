@@ -22,6 +22,32 @@ pub struct Material {
     pub damping: f64,
 }
 
+/// A material file's text (a `[material]` table, as `hooke drape FILE.toml` reads it) as
+/// its spec; `path` only names it in the error, which says what TOML found wrong and where.
+///
+/// ```
+/// use std::path::Path;
+/// let spec = hooke_scene::material::parse_material_file(
+///     "[material]\npreset = \"cotton\"\nbending = 2e-6\n",
+///     Path::new("m.toml"),
+/// )
+/// .unwrap();
+/// assert_eq!(spec.resolve("material").unwrap().bending, 2e-6);
+/// assert!(hooke_scene::material::parse_material_file("[material]\nmass = 1\n", Path::new("m.toml"))
+///     .unwrap_err()
+///     .starts_with("m.toml: "));
+/// ```
+pub fn parse_material_file(text: &str, path: &std::path::Path) -> Result<MaterialSpec, String> {
+    #[derive(serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct File {
+        material: MaterialSpec,
+    }
+    toml::from_str::<File>(text)
+        .map(|f| f.material)
+        .map_err(|e| format!("{}: {e}", path.display()))
+}
+
 /// A named material and where its figures come from.
 pub struct Preset {
     /// The name `preset = "…"` takes.
