@@ -202,6 +202,7 @@ impl StepTimes {
         let started = Instant::now();
         let mut last = started;
         let mut untimed = std::time::Duration::ZERO;
+        let _polling = hooke::interrupt::Polling::start();
         for _ in 0..steps {
             // An atomic load per step: far below the timer reads around it.
             hooke::interrupt::check(simulation)?;

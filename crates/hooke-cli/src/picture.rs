@@ -60,6 +60,9 @@ pub fn demo(out: &Path, view: &View) -> Result<ExitCode> {
         .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
     // Two demos writing one folder would mix their stills.
     let _held = hooke::output::lock::FolderLock::take(out, "--out")?;
+    // Each scene's run asks for interrupts; one arriving while the next scene is built is
+    // answered at its first step, after the stills written so far.
+    let _polling = hooke::interrupt::Polling::start();
     // Every name the demo writes, checked before the first scene runs.
     for (k, (name, _)) in BUILTINS.iter().enumerate() {
         hooke::output::check_named(&out.join(still_name(k, name)), "--out")?;

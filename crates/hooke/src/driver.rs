@@ -154,6 +154,8 @@ fn steps(scene: &mut Scene, n: u64, bar: &dyn Progress) -> Result<()> {
 pub fn drive(scene: &mut Scene, mut on_frame: impl FnMut(u64, &Scene) -> Result<()>) -> Result<()> {
     let (total, every) = (scene.steps, scene.every);
     let bar = progress(scene, total);
+    // A frame being written when an interrupt comes is finished before the run stops.
+    let _polling = interrupt::Polling::start();
     on_frame(0, scene)?;
     for frame in 1..=total / every {
         steps(scene, every, bar.as_ref())?;

@@ -27,11 +27,15 @@ pub const ANSWER_WITHIN: Duration = Duration::from_millis(500);
 /// [`ANSWER_WITHIN`] (a large implicit step), and its run still ends in order after it.
 static LOOPS: AtomicU32 = AtomicU32::new(0);
 
-/// A run's loop that asks for interrupts between its steps, while it lives.
-pub(crate) struct Polling;
+/// A job that asks for interrupts between its steps ([`requested`], [`check`]), while it
+/// lives: an interrupt then waits for its next question however long a step (or a build
+/// between two runs of the job) takes, and the job stops in order.
+pub struct Polling;
 
 impl Polling {
-    pub(crate) fn start() -> Self {
+    /// Declares a polling job under way until the value is dropped.
+    #[must_use = "the job polls only while the value lives"]
+    pub fn start() -> Self {
         LOOPS.fetch_add(1, Ordering::SeqCst);
         Polling
     }

@@ -72,6 +72,9 @@ const ENERGY_TOLERANCE: f64 = 0.01;
 
 /// Runs every check and writes the page into `dir` (created if missing).
 pub fn write(dir: &Path, options: &Options) -> Result<Outcome> {
+    // The report's runs ask for interrupts between their steps and stop it in order
+    // (leaving the earlier report, or nothing, and its folder unlocked).
+    let _polling = crate::interrupt::Polling::start();
     let quick = options.quick;
     let checked = scenes::names(quick);
     // Before anything is written: a report that cannot compare cannot run.
