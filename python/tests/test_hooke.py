@@ -351,15 +351,29 @@ def test_report_writes_the_page_and_its_numbers(tmp_path):
         assert abs(slope - expected) <= 0.1, (name, slope, expected)
 
 
-def test_a_mesh_body_loads_with_its_faces_and_its_files_vertices():
+def test_a_mesh_body_loads_with_its_faces_and_its_files_vertices(tmp_path):
     examples = ROOT / "assets" / "examples"
     sim = hooke.load(str(examples / "flag-hole.toml"), steps=10)
     faces = sim.faces
     assert faces.shape[1] == 3 and faces.dtype == np.int64
     assert faces.min() >= 0 and faces.max() < len(sim.positions)
     vertices, triangles = sim.mesh("flag")
-    # The OBJ's 651 vertices, in its order, though 30 of them are in no face.
-    assert vertices.shape == (651, 3) and len(sim.positions) == 621
-    assert triangles.max() < 651
+    # The OBJ's 621 vertices, in its order, each a particle.
+    assert vertices.shape == (621, 3) and len(sim.positions) == 621
+    assert triangles.max() < 621
     with pytest.raises(hooke.HookeError, match="no body 'cloth'"):
         sim.mesh("cloth")
+    # A vertex in no face is handed back too, in its place, though it is no particle.
+    (tmp_path / "quad.obj").write_text(
+        "v 0 0 0\nv 0.1 0 0\nv 9 9 9\nv 0.1 0 0.1\nv 0 0 0.1\nf 1 2 4 5\n"
+    )
+    (tmp_path / "quad.toml").write_text(
+        'name = "quad"\n[simulation]\nintegrator = "symplectic"\ndt = 0.0001\nsteps = 1\n'
+        'every = 1\n[[body]]\nname = "quad"\nshape = { kind = "mesh", path = "quad.obj" }\n'
+        'material = { preset = "cotton" }\n'
+    )
+    sim = hooke.load(str(tmp_path / "quad.toml"), steps=1)
+    vertices, triangles = sim.mesh("quad")
+    assert vertices.shape == (5, 3) and len(sim.positions) == 4
+    assert tuple(vertices[2]) == (9.0, 9.0, 9.0)
+    assert 2 not in set(triangles.ravel().tolist())
