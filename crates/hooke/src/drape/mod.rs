@@ -556,18 +556,23 @@ pub fn fit_bending(
 mod tests {
     use super::*;
 
-    /// A target above (or below) every DC the range of B gives is said to lie outside
-    /// it; one inside is not.
-    #[test]
-    fn a_target_no_rigidity_reaches_is_outside_the_fit() {
-        let dc = |b: f64| 0.4 + 0.1 * (b / 1e-5).ln().tanh();
-        let base = Material {
+    /// A cotton-like fabric whose rigidity the fits set.
+    fn fabric() -> Material {
+        Material {
             density: 0.15,
             stretch: 1000.0,
             shear: 50.0,
             bending: 0.0,
             damping: 1e-5,
-        };
+        }
+    }
+
+    /// A target above (or below) every DC the range of B gives is said to lie outside
+    /// it; one inside is not.
+    #[test]
+    fn a_target_no_rigidity_reaches_is_outside_the_fit() {
+        let dc = |b: f64| 0.4 + 0.1 * (b / 1e-5).ln().tanh();
+        let base = fabric();
         for (target, outside) in [(0.9, true), (0.2, true), (0.45, false)] {
             let fit = fit_bending(target, &base, 0.02, &mut |m| Ok(dc(m.bending))).unwrap();
             assert_eq!(fit.outside(target), outside, "{target}: {fit:?}");
@@ -580,13 +585,7 @@ mod tests {
     fn the_fit_recovers_a_rigidity_from_a_rising_coefficient() {
         let truth = 7.3e-6;
         let dc = |b: f64| 1.0 - 1.0 / (1.0 + (b / 2e-5).powf(0.8));
-        let base = Material {
-            density: 0.15,
-            stretch: 1000.0,
-            shear: 50.0,
-            bending: 0.0,
-            damping: 1e-5,
-        };
+        let base = fabric();
         let fit = fit_bending(dc(truth), &base, 0.02, &mut |m| Ok(dc(m.bending))).unwrap();
         assert!((fit.bending / truth - 1.0).abs() < 0.03, "{fit:?}");
         assert!(fit.evaluations <= 10, "{fit:?}");
