@@ -6,6 +6,8 @@
 mod common;
 
 use common::*;
+use std::path::Path;
+use std::process::Output;
 
 /// Writes `text` as `name` in `dir`.
 fn write(dir: &std::path::Path, name: &str, text: &str) {
@@ -239,14 +241,19 @@ fn the_advised_step_is_one_hooke_accepts() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `hooke ARGS` in `dir`, its stderr a log that gets a line of progress after every step.
+fn with_progress_lines(dir: &Path, args: &[&str]) -> Output {
+    hooke_in(dir)
+        .args(args)
+        .env("HOOKE_PROGRESS_SECONDS", "0")
+        .output()
+        .unwrap()
+}
+
 #[test]
 fn a_long_run_into_a_log_says_how_far_it_got() {
     let dir = scratch("progress");
-    let out = hooke_in(&dir)
-        .args(["run", "chain", "--steps", "50"])
-        .env("HOOKE_PROGRESS_SECONDS", "0")
-        .output()
-        .unwrap();
+    let out = with_progress_lines(&dir, &["run", "chain", "--steps", "50"]);
     let said = stderr(&out);
     assert!(out.status.success(), "{said}");
     assert!(said.contains("chain: step 50 of 50 (100 %)"), "{said}");
@@ -258,11 +265,10 @@ fn a_long_run_into_a_log_says_how_far_it_got() {
 #[test]
 fn a_drapes_progress_says_its_time_left_is_at_most() {
     let dir = scratch("drape-progress");
-    let out = hooke_in(&dir)
-        .args(["drape", "silk", "--repeats", "1", "--longest", "0.02"])
-        .env("HOOKE_PROGRESS_SECONDS", "0")
-        .output()
-        .unwrap();
+    let out = with_progress_lines(
+        &dir,
+        &["drape", "silk", "--repeats", "1", "--longest", "0.02"],
+    );
     let said = stderr(&out);
     assert!(
         said.contains("drape silk, repeat 1 of 1: step 1 of at most ")
