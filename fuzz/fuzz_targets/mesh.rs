@@ -16,15 +16,10 @@ fuzz_target!(|data: &[u8]| {
     if std::fs::write(&path, data).is_err() {
         return;
     }
+    let quoted = format!("{:?}", path.display().to_string());
     for shape in [
-        format!(
-            "{{ kind = \"mesh\", path = {:?} }}",
-            path.display().to_string()
-        ),
-        format!(
-            "{{ kind = \"solid\", path = {:?}, spacing = 0.05 }}",
-            path.display().to_string()
-        ),
+        format!("{{ kind = \"mesh\", path = {quoted} }}"),
+        format!("{{ kind = \"solid\", path = {quoted}, spacing = 0.05 }}"),
     ] {
         let text = format!(
             "name = \"fuzz\"\n[simulation]\nintegrator = \"symplectic\"\ndt = 0.001\nsteps = 1\n\
@@ -32,8 +27,8 @@ fuzz_target!(|data: &[u8]| {
         );
         let spec =
             hooke_scene::parse_scene(&text, "fuzz.toml").expect("the scene around the mesh reads");
-        // The footprint guard `hooke run` applies before it builds (a mesh of many vertices
-        // or a solid of many cells is refused, not built).
+        // `hooke run` refuses a scene over its memory budget before building it; here the
+        // budget is a fixed 256 MiB, so that a fuzz run builds many inputs a second.
         let footprint = spec.footprint(&std::env::temp_dir());
         if footprint.bytes() > 256 << 20 {
             continue;

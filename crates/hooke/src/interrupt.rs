@@ -60,7 +60,8 @@ pub fn install() {
     let result = ctrlc::set_handler(|| {
         let count = INTERRUPTS.fetch_add(1, Ordering::SeqCst) + 1;
         if count == 1 {
-            // The handler runs on a thread of its own: it may wait for the answer there.
+            // Waited for on a thread of its own, so that the handler stays free to take a
+            // second and a third interrupt meanwhile.
             std::thread::spawn(|| {
                 std::thread::sleep(ANSWER_WITHIN);
                 if !ANSWERED.load(Ordering::SeqCst) && LOOPS.load(Ordering::SeqCst) == 0 {
