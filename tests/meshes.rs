@@ -12,7 +12,7 @@ use hooke_scene::{Scene, example_meshes};
 use std::path::{Path, PathBuf};
 
 /// A fresh folder for this test's files.
-fn folder(tag: &str) -> PathBuf {
+pub(crate) fn folder(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("hooke-meshes-{tag}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
@@ -20,7 +20,7 @@ fn folder(tag: &str) -> PathBuf {
 }
 
 /// OBJ text of `vertices` and polygon `faces` (0-based).
-fn obj(vertices: &[Vec3], faces: &[Vec<u32>]) -> String {
+pub(crate) fn obj(vertices: &[Vec3], faces: &[Vec<u32>]) -> String {
     let mut s = String::new();
     for v in vertices {
         s += &format!("v {} {} {}\n", v.x, v.y, v.z);
@@ -33,7 +33,7 @@ fn obj(vertices: &[Vec3], faces: &[Vec<u32>]) -> String {
 }
 
 /// The scene `text` built with its files in `dir`; an error as its whole chain.
-fn build(text: &str, dir: &Path) -> Result<Scene, String> {
+pub(crate) fn build(text: &str, dir: &Path) -> Result<Scene, String> {
     hooke_scene::parse_scene(text, "mesh.toml")
         .map_err(|e| e.to_string())?
         .build(dir)
@@ -379,7 +379,7 @@ fn meshes_with_seams_holes_and_quads_never_cross() {
 
 /// A scene of 2 s of block descent at 1/60 s: the cloth of mesh `path` in `preset`, 1.1 m up,
 /// dropped on the ground and the round table (with `table`'s keys, such as a scale).
-fn dropped_on_the_table(path: &str, preset: &str, table: &str) -> String {
+pub(crate) fn dropped_on_the_table(path: &str, preset: &str, table: &str) -> String {
     let table = if table.is_empty() {
         String::new()
     } else {

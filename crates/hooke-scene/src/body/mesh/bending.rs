@@ -13,6 +13,7 @@
 //! `Σ K_i = 0`, `|Σ K_i x_i|² = −Σ_{i<j} K_i K_j |x_i − x_j|²`: six springs of rest length
 //! zero and stiffness `−w K_i K_j`, with `w = B / (A₁ + A₂)`.
 
+use crate::body::mesh::sheet::canonical;
 use hooke_core::Vec3;
 use std::collections::{BTreeMap, HashMap};
 
@@ -37,6 +38,9 @@ pub(crate) fn pieces(polygons: &[Vec<u32>]) -> Vec<Piece> {
     let mut out = Vec::new();
     for (f, p) in polygons.iter().enumerate() {
         let face = f as u32;
+        // Read from the lowest-numbered corner, so that the pieces do not depend on where
+        // the file starts the face or which way it winds.
+        let p = canonical(p);
         if p.len() == 4 {
             for (cut, tris) in [
                 [[p[0], p[1], p[2]], [p[0], p[2], p[3]]],

@@ -14,7 +14,7 @@ use crate::scene::Topology;
 use crate::spec::{BodySpec, PinRegion, Pins, SpringParams};
 use hooke_collide::PolygonMesh;
 use hooke_core::{Spring, SpringKind, Vec3};
-use sheet::{Sheet, polygon_area};
+use sheet::{Sheet, canonical, polygon_area};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -123,7 +123,7 @@ pub(crate) fn jelly(
         triangles: Some(filled.boundary),
         skin: Some(filled.skin),
         pins,
-        warnings: Vec::new(),
+        warnings: filled.warnings,
         local: filled.local,
     })
 }
@@ -163,9 +163,9 @@ fn fabric_masses(sheet: &Sheet, m: &Material) -> Vec<f64> {
 fn membrane_springs(sheet: &Sheet, m: &Material) -> BTreeMap<(u32, u32), (f64, f64, SpringKind)> {
     let x = &sheet.local;
     let mut out: BTreeMap<(u32, u32), (f64, f64, SpringKind)> = BTreeMap::new();
-    for p in &sheet.polygons {
+    for p in sheet.polygons.iter().map(|p| canonical(p)) {
         // A quad is one element: its sides and both diagonals. Larger polygons are fans of
-        // triangles, each its own element.
+        // triangles (from the lowest-numbered corner), each its own element.
         let elements: Vec<Vec<u32>> = if p.len() <= 4 {
             vec![p.clone()]
         } else {
@@ -237,7 +237,7 @@ fn plain_springs(sheet: &Sheet, body: &BodySpec, offset: usize) -> Vec<Spring> {
     let x = &sheet.local;
     let mut by_kind: BTreeMap<(u32, u32), SpringKind> = BTreeMap::new();
     let mut sides: BTreeMap<(u32, u32), Vec<u32>> = BTreeMap::new();
-    for p in &sheet.polygons {
+    for p in sheet.polygons.iter().map(|p| canonical(p)) {
         for k in 0..p.len() {
             let (a, b) = (p[k], p[(k + 1) % p.len()]);
             by_kind.insert((a.min(b), a.max(b)), SpringKind::Structural);

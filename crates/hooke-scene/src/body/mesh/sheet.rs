@@ -216,22 +216,62 @@ pub(crate) fn sheet(
     })
 }
 
-/// A polygon's triangles: a quad along its shorter diagonal (so a skinny quad is not cut
-/// into two slivers), anything else as a fan from its first corner.
-pub(crate) fn split(p: &[u32], x: &[Vec3]) -> Vec<[u32; 3]> {
-    if p.len() == 4 {
-        let d02 = (x[p[0] as usize] - x[p[2] as usize]).norm_squared();
-        let d13 = (x[p[1] as usize] - x[p[3] as usize]).norm_squared();
-        if d13 < d02 {
-            return vec![[p[0], p[1], p[3]], [p[1], p[2], p[3]]];
-        }
-        return vec![[p[0], p[1], p[2]], [p[0], p[2], p[3]]];
+/// A polygon of four or more corners read from its lowest-numbered corner toward the lower
+/// of that corner's two neighbours: the same list whichever corner a file starts a face on
+/// and whichever way it winds, so that what is computed from a face (its cut, its fan, its
+/// area, its membrane) is the same bits for the same fabric. A triangle, which has only
+/// one cut, is kept as written (so the built-in meshes keep their bits).
+pub(crate) fn canonical(p: &[u32]) -> Vec<u32> {
+    let n = p.len();
+    let Some(first) = (0..n).min_by_key(|&k| p[k]).filter(|_| n > 3) else {
+        return p.to_vec();
+    };
+    let (next, prev) = (p[(first + 1) % n], p[(first + n - 1) % n]);
+    if next <= prev {
+        (0..n).map(|k| p[(first + k) % n]).collect()
+    } else {
+        (0..n).map(|k| p[(first + n - k) % n]).collect()
     }
-    (1..p.len() - 1).map(|k| [p[0], p[k], p[k + 1]]).collect()
 }
 
-/// The area of a polygon (Newell's method: exact for planar ones).
+/// Whether `canonical(p)` winds as `p` does.
+fn winds_as_given(p: &[u32], c: &[u32]) -> bool {
+    let n = p.len();
+    let first = p.iter().position(|&v| v == c[0]).unwrap_or(0);
+    n < 3 || p[(first + 1) % n] == c[1]
+}
+
+/// A polygon's triangles, wound as the polygon is: a quad along its shorter diagonal (so a
+/// skinny quad is not cut into two slivers; of two equal ones, the one through the
+/// lowest-numbered corner), anything else as a fan from its lowest-numbered corner. The
+/// cut does not depend on the corner a face starts on or on its winding.
+pub(crate) fn split(p: &[u32], x: &[Vec3]) -> Vec<[u32; 3]> {
+    let c = canonical(p);
+    let mut out: Vec<[u32; 3]> = if c.len() == 4 {
+        let d02 = (x[c[0] as usize] - x[c[2] as usize]).norm_squared();
+        let d13 = (x[c[1] as usize] - x[c[3] as usize]).norm_squared();
+        if d13 < d02 {
+            vec![[c[0], c[1], c[3]], [c[1], c[2], c[3]]]
+        } else {
+            vec![[c[0], c[1], c[2]], [c[0], c[2], c[3]]]
+        }
+    } else {
+        (1..c.len().saturating_sub(1))
+            .map(|k| [c[0], c[k], c[k + 1]])
+            .collect()
+    };
+    if !winds_as_given(p, &c) {
+        for t in &mut out {
+            t.swap(1, 2);
+        }
+    }
+    out
+}
+
+/// The area of a polygon (Newell's method: exact for planar ones), summed in the canonical
+/// order so that it is the same bits however the face is written.
 pub(crate) fn polygon_area(p: &[u32], x: &[Vec3]) -> f64 {
+    let p = &canonical(p)[..];
     let mut n = Vec3::zeros();
     for k in 0..p.len() {
         let (a, b) = (x[p[k] as usize], x[p[(k + 1) % p.len()] as usize]);

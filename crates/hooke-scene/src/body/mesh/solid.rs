@@ -25,6 +25,8 @@ pub(crate) struct Filled {
     pub(crate) boundary: Vec<[u32; 3]>,
     /// The user's mesh riding the lattice (local particle indices).
     pub(crate) skin: Skin,
+    /// What the user should know about the mesh (it is filled all the same).
+    pub(crate) warnings: Vec<String>,
 }
 
 /// Fills `mesh` (from `path`, its coordinates times `scale`) with a lattice of `spacing`,
@@ -66,6 +68,19 @@ pub(crate) fn fill(
                 if open == 1 { "" } else { "s" },
                 if open == 1 { "is" } else { "are" }
             ),
+        ));
+    }
+    // The winding number's magnitude fills an inside-out mesh as well as any, but its
+    // normals point in: drawn and exported, its faces show their backs.
+    let mut warnings = Vec::new();
+    let volume = enclosed_volume(&x, &triangles);
+    if volume < 0.0 {
+        warnings.push(format!(
+            "{shown}: its faces wind inward (their normals point into the solid; the volume \
+             they enclose by their winding is {:.3e} m³): it is filled all the same, but its \
+             drawn and exported surface faces inward; flip the faces' winding in the program \
+             that made it (Blender: Mesh ▸ Normals ▸ Recalculate Outside)",
+            volume
         ));
     }
     let used: Vec<u32> = {
@@ -265,6 +280,7 @@ pub(crate) fn fill(
         springs,
         boundary,
         skin,
+        warnings,
     })
 }
 
