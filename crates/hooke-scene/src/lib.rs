@@ -33,6 +33,7 @@ pub mod footprint;
 pub mod generators;
 mod limits;
 pub mod material;
+mod overlaps;
 mod overrides;
 mod ranges;
 mod scene;

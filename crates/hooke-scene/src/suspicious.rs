@@ -1,7 +1,8 @@
 //! What a scene as built does that its author probably did not mean: bodies that start
 //! inside a collider, cloth that starts below the top of a table it hangs over (it falls
 //! beside or under the table and wraps its pedestal instead of landing on it), tables of a
-//! single triangle. Said as warnings: such scenes still run.
+//! single triangle, and surfaces that start too near each other (`crate::overlaps`). Said
+//! as warnings: such scenes still run.
 
 use crate::scene::{ColliderGeometry, Scene};
 use hooke_core::{Num, Vec3};
@@ -134,7 +135,8 @@ impl Scene {
                 }
             }
         }
-        said.extend(self.overlapping_bodies());
+        said.extend(crate::overlaps::overlapping_bodies(self));
+        said.extend(crate::overlaps::overlapping_pieces(self));
         said
     }
 
@@ -205,118 +207,4 @@ impl Scene {
         })
         .collect()
     }
-
-    /// Pairs of bodies that start through each other, or nearer than the sum of their
-    /// contact thicknesses: a spring of one passing that near a triangle of the other.
-    fn overlapping_bodies(&self) -> Vec<String> {
-        let x = &self.simulation.particles().x;
-        let springs = &self.simulation.model().springs;
-        let mut said = Vec::new();
-        for (a, body) in self.bodies.iter().enumerate() {
-            for (b, other) in self.bodies.iter().enumerate() {
-                if a == b || other.triangles.is_empty() || (a > b && !body.triangles.is_empty()) {
-                    // Each pair once, but a body without triangles only from its side.
-                    continue;
-                }
-                let reach = body.thickness + other.thickness;
-                let mut near =
-                    spring_triangle_hits(x, springs, &body.range, &other.triangles, reach);
-                if !body.triangles.is_empty() {
-                    near += spring_triangle_hits(x, springs, &other.range, &body.triangles, reach);
-                }
-                if near > 0 {
-                    said.push(format!(
-                        "bodies '{}' and '{}' start through each other or nearer than their \
-                         contact thicknesses ({} m together): {near} of their springs pass \
-                         that near the other's surface, and the contacts will tear them apart \
-                         in the first steps; start them further apart",
-                        body.name,
-                        other.name,
-                        Num(reach)
-                    ));
-                }
-            }
-        }
-        said
-    }
-}
-
-/// How many springs with both ends in `range` pass within `reach` (or through) any of
-/// `triangles`, found through a uniform grid of the triangles' boxes.
-fn spring_triangle_hits(
-    x: &[Vec3],
-    springs: &[hooke_core::Spring],
-    range: &std::ops::Range<usize>,
-    triangles: &[[u32; 3]],
-    reach: f64,
-) -> usize {
-    use hooke_core::contact::proximity::segment_triangle;
-    use std::collections::HashMap;
-    let corners = |t: &[u32; 3]| t.map(|i| x[i as usize]);
-    let bounds = |points: &[Vec3]| {
-        let inf = Vec3::repeat(f64::INFINITY);
-        points
-            .iter()
-            .fold((inf, -inf), |(lo, hi), p| (lo.inf(p), hi.sup(p)))
-    };
-    let mine: Vec<&hooke_core::Spring> = springs
-        .iter()
-        .filter(|s| range.contains(&(s.i as usize)) && range.contains(&(s.j as usize)))
-        .collect();
-    let (lo_a, hi_a) = bounds(&x[range.clone()]);
-    let (lo_b, hi_b) = bounds(&triangles.iter().flat_map(corners).collect::<Vec<_>>());
-    let apart = (0..3).any(|k| lo_a[k] > hi_b[k] + reach || lo_b[k] > hi_a[k] + reach);
-    if mine.is_empty() || apart {
-        return 0;
-    }
-    // Cells about a triangle's size: each spring meets a few.
-    let longest = triangles
-        .iter()
-        .map(|t| {
-            let [p, q, r] = corners(t);
-            (p - q).norm().max((q - r).norm()).max((r - p).norm())
-        })
-        .fold(0.0f64, f64::max);
-    let cell = longest.max(reach).max(1e-6);
-    let key = |p: &Vec3| p.map(|c| (c / cell).floor() as i64);
-    let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
-    for (k, t) in triangles.iter().enumerate() {
-        let (lo, hi) = bounds(&corners(t));
-        let (lo, hi) = (key(&lo.add_scalar(-reach)), key(&hi.add_scalar(reach)));
-        for i in lo.x..=hi.x {
-            for j in lo.y..=hi.y {
-                for l in lo.z..=hi.z {
-                    grid.entry([i, j, l]).or_default().push(k);
-                }
-            }
-        }
-    }
-    let reach2 = reach.max(1e-9).powi(2);
-    mine.iter()
-        .filter(|s| {
-            let (p, q) = (x[s.i as usize], x[s.j as usize]);
-            let (lo, hi) = bounds(&[p, q]);
-            let (lo, hi) = (key(&lo), key(&hi));
-            let mut seen = std::collections::HashSet::new();
-            for i in lo.x..=hi.x {
-                for j in lo.y..=hi.y {
-                    for l in lo.z..=hi.z {
-                        for &k in grid.get(&[i, j, l]).into_iter().flatten() {
-                            if !seen.insert(k) {
-                                continue;
-                            }
-                            let [a, b, c] = corners(&triangles[k]);
-                            let (t, w) = segment_triangle(&p, &q, &a, &b, &c);
-                            let on_segment = p + (q - p) * t;
-                            let on_triangle = a * w[0] + b * w[1] + c * w[2];
-                            if (on_segment - on_triangle).norm_squared() < reach2 {
-                                return true;
-                            }
-                        }
-                    }
-                }
-            }
-            false
-        })
-        .count()
 }
