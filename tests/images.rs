@@ -1,5 +1,6 @@
 //! Image goldens: a still of each built-in scene and of one jello world, rendered and
-//! compared with `golden/<name>.png` as decoded pixels.
+//! compared with `golden/<name>.png` as decoded pixels; and what a picture must show:
+//! shadows where the geometry puts them, strain reddest at the pins, a solid's flat faces.
 //!
 //! **Tolerance** (`hooke::report::pixels`, which `hooke report` uses too). A pixel matches
 //! when each channel is within [`CHANNEL_TOLERANCE`] levels; an image matches when at most
@@ -344,4 +345,105 @@ fn the_hanging_cloth_is_reddest_by_strain_at_its_pinned_corners() {
         legend.end_labels(),
         (hooke_render::short(range.1), hooke_render::short(range.0))
     );
+}
+
+/// A jelly filling a cube mesh is drawn with flat faces: across the face nearest the
+/// camera (away from its edges) every pixel is within 3 levels of the others. Smooth
+/// normals averaged across the 90° corners shaded that face as a rounded one, with shadow
+/// acne on it: a spread of tens of levels.
+#[test]
+fn a_solid_cube_is_drawn_with_flat_faces() {
+    use hooke_core::Vec3;
+    let dir = std::env::temp_dir().join(format!("hooke-flat-faces-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let corner = |i: u32| Vec3::new((i >> 2 & 1) as f64, (i >> 1 & 1) as f64, (i & 1) as f64);
+    let quads: [[u32; 4]; 6] = [
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+    ];
+    let mut obj = String::new();
+    for i in 0..8 {
+        let p = corner(i) * 0.6;
+        obj += &format!("v {} {} {}\n", p.x, p.y, p.z);
+    }
+    for q in &quads {
+        obj += &format!("f {} {} {} {}\n", q[0] + 1, q[1] + 1, q[2] + 1, q[3] + 1);
+    }
+    std::fs::write(dir.join("cube.obj"), obj).unwrap();
+    let text = r#"
+name = "cube"
+[simulation]
+integrator = "symplectic"
+dt = 0.0005
+duration = 0.001
+every = 1
+[[body]]
+name = "jelly"
+mass = 0.05
+origin = [-0.3, 0.01, -0.3]
+rotate = [0.0, 30.0, 0.0]
+shape = { kind = "solid", path = "cube.obj", spacing = 0.1 }
+[body.springs.structural]
+ks = 600.0
+kd = 1.0
+[[collider]]
+shape = { kind = "ground", height = 0.0 }
+response = { kind = "restitution", cr = 0.0, friction = 0.5 }
+"#;
+    let scene = hooke_scene::parse_scene(text, "cube.toml")
+        .unwrap()
+        .build(&dir)
+        .unwrap();
+    let view = View {
+        size: (400, 300),
+        ..View::default()
+    };
+    let camera = view.camera(&scene);
+    let image = view.pixels(&scene, &camera);
+    let (w, h) = image.dimensions();
+    let mut v = Vec::new();
+    scene.bodies[0].vertices(&scene.simulation.particles().x, &mut v);
+    let eye = camera.eye();
+    // The face most squarely toward the camera.
+    let (face, centre) = quads
+        .iter()
+        .map(|q| {
+            let c = q.iter().map(|&i| v[i as usize]).sum::<Vec3>() / 4.0;
+            let [a, b, d] = [q[0], q[1], q[3]].map(|i| v[i as usize]);
+            let n = (b - a).cross(&(d - a)).normalize();
+            (n.dot(&(eye - c).normalize()), q, c)
+        })
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, q, c)| (q, c))
+        .unwrap();
+    let project = camera.view_projection(w as f64 / h as f64);
+    let pixel = |q: Vec3| {
+        let c = project * nalgebra::Vector4::new(q.x, q.y, q.z, 1.0);
+        let (x, y) = (
+            (c.x / c.w + 1.0) * 0.5 * w as f64,
+            (1.0 - c.y / c.w) * 0.5 * h as f64,
+        );
+        let p = image.get_pixel(x as u32, y as u32).0;
+        p[0] as i32 + p[1] as i32 + p[2] as i32
+    };
+    // A grid over the middle 70 % of the face.
+    let [a, b, _, d] = face.map(|i| v[i as usize]);
+    let (u, s) = (b - a, d - a);
+    let mut levels = Vec::new();
+    for i in 0..=10 {
+        for j in 0..=10 {
+            let (fu, fs) = (0.15 + 0.07 * i as f64, 0.15 + 0.07 * j as f64);
+            levels.push(pixel(a + u * fu + s * fs));
+        }
+    }
+    let spread = levels.iter().max().unwrap() - levels.iter().min().unwrap();
+    assert!(
+        spread <= 9,
+        "the face about {centre:?} spans {spread} levels (summed over RGB)"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }

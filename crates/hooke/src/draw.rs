@@ -129,12 +129,23 @@ fn skin(list: &mut DrawList, (x, tint): (&[Vec3], Option<&[Rgb]>), body: &Body, 
             })
             .collect()
     });
-    list.meshes.push(Mesh {
+    // A solid's box corners are edges, not curves; a cloth's folds stay smooth.
+    let drawn = crate::creases::Drawn {
         positions,
         normals,
         triangles,
-        color,
         colors,
+    };
+    let drawn = match body.topology {
+        Topology::Solid => crate::creases::split(drawn),
+        _ => drawn,
+    };
+    list.meshes.push(Mesh {
+        positions: drawn.positions,
+        normals: drawn.normals,
+        triangles: drawn.triangles,
+        color,
+        colors: drawn.colors,
     });
 }
 

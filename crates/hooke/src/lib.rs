@@ -37,6 +37,7 @@
 
 #![forbid(unsafe_code)]
 
+mod creases;
 pub mod drape;
 pub mod draw;
 pub mod driver;

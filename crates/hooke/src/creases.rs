@@ -1,0 +1,160 @@
+//! Hard edges of a drawn solid: where its faces meet at more than [`CREASE`], a corner takes
+//! the normal of the faces on its own side only, so a jelly cube's faces are drawn flat up
+//! to its edges instead of rounded across them (and a shadow lookup lifted along the normal
+//! leaves each face, not the corner's average). A smooth surface, whose faces all meet
+//! within the angle, keeps its vertex normals bit for bit.
+
+use hooke_core::Vec3;
+use hooke_render::Rgb;
+
+/// The angle between two faces' normals beyond which the edge between them is drawn hard:
+/// Blender's auto-smooth default is 30°; a deformed lattice's box corner stays near 90°.
+const CREASE: f64 = 45.0;
+
+/// A mesh to draw: positions, a unit normal per position, triangles and per-position
+/// colours (empty for one colour).
+pub(crate) struct Drawn {
+    pub(crate) positions: Vec<Vec3>,
+    pub(crate) normals: Vec<Vec3>,
+    pub(crate) triangles: Vec<[u32; 3]>,
+    pub(crate) colors: Vec<Rgb>,
+}
+
+/// `mesh` with every vertex where faces meet beyond [`CREASE`] split into one copy per
+/// distinct normal of its corners, each corner's normal the area-weighted sum of the
+/// vertex's faces within the angle of its own face.
+pub(crate) fn split(mesh: Drawn) -> Drawn {
+    let Drawn {
+        mut positions,
+        mut normals,
+        mut triangles,
+        mut colors,
+    } = mesh;
+    let x = positions.clone();
+    let face: Vec<Vec3> = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| x[i as usize]);
+            (b - a).cross(&(c - a))
+        })
+        .collect();
+    let unit: Vec<Vec3> = face
+        .iter()
+        .map(|n| n.try_normalize(0.0).unwrap_or_else(Vec3::zeros))
+        .collect();
+    let mut around: Vec<Vec<(usize, usize)>> = vec![Vec::new(); x.len()];
+    for (t, corners) in triangles.iter().enumerate() {
+        for (k, &v) in corners.iter().enumerate() {
+            around[v as usize].push((t, k));
+        }
+    }
+    let smooth = CREASE.to_radians().cos();
+    for (v, corners) in around.iter().enumerate() {
+        let hard = corners
+            .iter()
+            .any(|&(t, _)| corners.iter().any(|&(u, _)| unit[t].dot(&unit[u]) < smooth));
+        if !hard {
+            continue;
+        }
+        // Each corner's normal from the faces on its side; equal normals share a vertex.
+        let mut made: Vec<(Vec3, u32)> = Vec::new();
+        for &(t, k) in corners {
+            let sum: Vec3 = corners
+                .iter()
+                .filter(|&&(u, _)| unit[t].dot(&unit[u]) >= smooth)
+                .map(|&(u, _)| face[u])
+                .sum();
+            let n = sum.try_normalize(0.0).unwrap_or(unit[t]);
+            let index = match made.iter().find(|(m, _)| *m == n) {
+                Some(&(_, i)) => i,
+                None => {
+                    let i = if made.is_empty() {
+                        normals[v] = n;
+                        v as u32
+                    } else {
+                        positions.push(x[v]);
+                        normals.push(n);
+                        if !colors.is_empty() {
+                            colors.push(colors[v]);
+                        }
+                        (positions.len() - 1) as u32
+                    };
+                    made.push((n, i));
+                    i
+                }
+            };
+            triangles[t][k] = index;
+        }
+    }
+    Drawn {
+        positions,
+        normals,
+        triangles,
+        colors,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit cube of 12 triangles wound outward.
+    fn cube() -> Drawn {
+        let positions: Vec<Vec3> = (0..8)
+            .map(|i| Vec3::new((i >> 2 & 1) as f64, (i >> 1 & 1) as f64, (i & 1) as f64))
+            .collect();
+        let quads = [
+            [0, 1, 3, 2],
+            [4, 6, 7, 5],
+            [0, 4, 5, 1],
+            [2, 3, 7, 6],
+            [0, 2, 6, 4],
+            [1, 5, 7, 3],
+        ];
+        let triangles = quads
+            .iter()
+            .flat_map(|q: &[u32; 4]| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect();
+        Drawn {
+            normals: vec![Vec3::zeros(); 8],
+            positions,
+            triangles,
+            colors: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_cube_is_drawn_with_each_face_flat() {
+        let out = split(cube());
+        // Three faces meet at each corner: three copies of each.
+        assert_eq!(out.positions.len(), 24);
+        for t in &out.triangles {
+            let [a, b, c] = t.map(|i| out.positions[i as usize]);
+            let n = (b - a).cross(&(c - a)).normalize();
+            for &i in t {
+                assert!((out.normals[i as usize] - n).norm() < 1e-12, "{t:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_smooth_surface_keeps_its_vertices_and_normals() {
+        // A shallow tent of two triangles, 20° apart: no hard edge.
+        let lift = 20f64.to_radians().tan() * 0.5;
+        let mesh = Drawn {
+            positions: vec![
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(0.5, lift, 1.0),
+                Vec3::new(0.5, lift, -1.0),
+            ],
+            normals: vec![Vec3::y(); 4],
+            triangles: vec![[0, 2, 1], [0, 1, 3]],
+            colors: Vec::new(),
+        };
+        let out = split(mesh);
+        assert_eq!(out.positions.len(), 4);
+        assert_eq!(out.normals, vec![Vec3::y(); 4]);
+        assert_eq!(out.triangles, vec![[0, 2, 1], [0, 1, 3]]);
+    }
+}
