@@ -5,6 +5,7 @@
 
 mod air;
 mod bodies;
+mod cancel;
 mod collisions;
 mod common;
 mod conservation;

@@ -143,6 +143,9 @@ fn steps(scene: &mut Scene, n: u64, bar: &dyn Progress) -> Result<()> {
         let stepped = scene.simulation.step();
         say_notices(scene);
         stepped?;
+        // A large step an interrupt cut short (`Simulation::set_cancel`) is no state to
+        // write: stop before any frame of it.
+        interrupt::check_after_step(&scene.simulation)?;
         bar.set(scene.simulation.steps());
     }
     Ok(())

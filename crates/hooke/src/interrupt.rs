@@ -110,6 +110,20 @@ pub fn check(simulation: &hooke_core::Simulation) -> Result<(), Interrupted> {
     }
 }
 
+/// Just after a step of `simulation`: an [`Interrupted`] error, if an interrupt arrived,
+/// that counts the step as not completed (an iterative step ends early at an interrupt,
+/// `Simulation::set_cancel`, so its state is not one to write or measure).
+pub fn check_after_step(simulation: &hooke_core::Simulation) -> Result<(), Interrupted> {
+    if requested() {
+        Err(Interrupted {
+            step: simulation.steps().saturating_sub(1),
+            time: (simulation.time() - simulation.dt()).max(0.0),
+        })
+    } else {
+        Ok(())
+    }
+}
+
 /// Whether `e` is an interrupt.
 pub fn is_interrupt(e: &crate::Error) -> bool {
     matches!(e, crate::Error::Interrupted { .. })

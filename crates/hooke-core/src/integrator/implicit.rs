@@ -50,6 +50,7 @@ pub(super) fn step(
 ) -> StepReport {
     let n = p.len();
     ws.x0.copy_from_slice(&p.x);
+    let cancel = ws.cancel;
     let buffers = &mut ws.implicit;
     let asm = &mut ws.assembly;
     let inv_mass = &p.inv_mass;
@@ -136,6 +137,12 @@ pub(super) fn step(
         d.copy_from_slice(z);
         let mut delta = parallel::dot(r, z);
         while iterations < CG_MAX_ITERATIONS {
+            // A product of a million particles' springs takes a quarter of a second and a
+            // step may run hundreds: Ctrl-C ends it here, unsolved (an atomic load an
+            // iteration), and the caller stops the run at its last complete frame.
+            if super::cancelled(cancel) {
+                break;
+            }
             iterations += 1;
             multiply(asm, d, q);
             let curvature = parallel::dot(d, q);

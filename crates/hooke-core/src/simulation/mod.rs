@@ -161,10 +161,12 @@ impl Simulation {
         self.workspace.stop = Some(rule);
     }
 
-    /// Installs a question the large steps (`vbd`, `newton`) ask between their iterations:
-    /// when `cancel` answers `true` the step under way ends early where it is (within its
-    /// bounds, as a capped step), so that the caller, which asked for it (Ctrl-C), can stop
-    /// the run within a fraction of a second whatever the tolerance and iteration budget.
+    /// Installs a question the iterative steps (`vbd`, `newton`, `implicit`) ask between
+    /// their iterations: when `cancel` answers `true` the step under way ends early where
+    /// it is (`vbd` and `newton` within their bounds, as a capped step; `implicit` with its
+    /// linear solve unfinished) and skips its contact phase and watches, so that the
+    /// caller, which asked for it (Ctrl-C) and must keep no state after it, can stop the
+    /// run within a fraction of a second whatever the tolerance and iteration budget.
     pub fn set_cancel(&mut self, cancel: fn() -> bool) {
         self.workspace.cancel = Some(cancel);
     }
@@ -315,6 +317,13 @@ impl Simulation {
             )
         };
         self.last = report;
+        if crate::integrator::cancelled(self.workspace.cancel) {
+            // The caller asked to stop (`set_cancel`) and keeps nothing of this step: its
+            // contact phase and watches (seconds on a large cloth) would only delay it.
+            self.step += 1;
+            self.end_pins(time + self.dt);
+            return Ok(());
+        }
         // Every scheme saves its start positions when the model has a contact phase.
         // Block descent keeps its contacts inside its own iterations.
         let moved = self.model.has_contact_phase()
