@@ -176,9 +176,46 @@ fn a_specimen_that_is_not_the_meters_disc_is_refused() {
         ..Meter::default()
     };
     let error = meter.scene(&preset("cotton"), 1).err().unwrap().to_string();
-    let _ = std::fs::remove_dir_all(&dir);
     assert!(
         error.contains("on-edge.obj") && error.contains("flat disc"),
+        "{error}"
+    );
+    // A regular polar disc of 48 sectors: its innermost edges are 1.3 mm, too short for
+    // the meter's 1 mm thickness, and the refusal names --mesh, not keys the meter sets.
+    let (sectors, rings) = (48usize, 15usize);
+    let mut text = String::from("v 0 0 0\n");
+    for r in 1..=rings {
+        for k in 0..sectors {
+            let (a, radius) = (
+                std::f64::consts::TAU * k as f64 / sectors as f64,
+                0.15 * r as f64 / rings as f64,
+            );
+            text += &format!("v {} 0 {}\n", radius * a.cos(), radius * a.sin());
+        }
+    }
+    let id = |r: usize, k: usize| 2 + (r - 1) * sectors + k % sectors;
+    for k in 0..sectors {
+        text += &format!("f 1 {} {}\n", id(1, k), id(1, k + 1));
+    }
+    for r in 1..rings {
+        for k in 0..sectors {
+            let q = [id(r, k), id(r + 1, k), id(r + 1, k + 1), id(r, k + 1)];
+            text += &format!("f {} {} {} {}\n", q[0], q[1], q[2], q[3]);
+        }
+    }
+    let fine = dir.join("fine.obj");
+    std::fs::write(&fine, text).unwrap();
+    let meter = Meter {
+        mesh: Some(fine),
+        ..Meter::default()
+    };
+    let error = meter.scene(&preset("cotton"), 1).err().unwrap().to_string();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(
+        error.contains("fine.obj")
+            && error.contains("shortest edge is 1.31 mm")
+            && error.contains("--mesh")
+            && !error.contains("self_collision"),
         "{error}"
     );
 }
