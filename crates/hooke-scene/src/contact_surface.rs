@@ -67,7 +67,7 @@ pub(crate) fn body_surface(
                 format!(
                     "{} m is not under half the surface's shortest edge ({shortest:.4} m): \
                      self-collision would push neighbouring particles apart; \
-                     use a thinner surface or self_collision = false",
+                     give a smaller `thickness` or `self_collision = false`",
                     Num(thickness)
                 ),
             ));

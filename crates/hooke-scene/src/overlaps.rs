@@ -36,7 +36,7 @@ pub(crate) fn overlapping_bodies(scene: &Scene) -> Vec<String> {
                     "bodies '{}' and '{}' start through each other or nearer than their \
                      contact thicknesses ({} m together): {near} of their springs pass \
                      that near the other's surface, and the contacts will tear them apart \
-                     in the first steps; start them further apart",
+                     in the first steps; start them further apart (their `origin`)",
                     body.name,
                     other.name,
                     Num(reach)

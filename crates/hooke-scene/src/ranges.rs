@@ -137,7 +137,7 @@ const FRICTION: Range = range(
     1e3,
     false,
     "a Coulomb friction coefficient",
-    "real surfaces have μ below about 2; 1e3 is a typo (use a stick response to hold)",
+    "real surfaces have μ below about 2; 1e3 is a typo (to hold, give `response = { kind = \"stick\" }`)",
 );
 /// Areal density of a material.
 const AREAL_DENSITY: Range = range(
