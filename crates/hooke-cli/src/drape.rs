@@ -23,7 +23,7 @@ pub struct DrapeArgs {
     #[arg(long, default_value_t = 5)]
     pub repeats: u32,
     /// The first repeat's seed (repeat k uses seed + k); the same seeds give the same bits.
-    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = parse_seed)]
     pub seed: u64,
     /// Print one JSON line instead of text.
     #[arg(long)]
@@ -406,4 +406,14 @@ pub fn drape(args: &DrapeArgs) -> Result<ExitCode> {
         );
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// A seed: a whole number from 0 (clap's own message for `-1` was "invalid digit").
+fn parse_seed(s: &str) -> Result<u64, String> {
+    s.trim().parse::<u64>().map_err(|_| {
+        format!(
+            "expected a whole number from 0 to {}, found '{s}'",
+            u64::MAX
+        )
+    })
 }

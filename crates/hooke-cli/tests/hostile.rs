@@ -571,6 +571,33 @@ fn the_drape_meter_refuses_what_it_cannot_measure() {
         &["--fit-dc", "1.5"],
     );
     refused(&dir, &["drape", "cotton", "--repeats", "0"], &["--repeats"]);
+    // Negative numbers reach the option's own check, not clap's "unexpected argument".
+    refused(
+        &dir,
+        &["drape", "cotton", "--seed", "-1"],
+        &["--seed", "whole number from 0", "'-1'"],
+    );
+    refused(
+        &dir,
+        &["drape", "cotton", "--bending", "-1"],
+        &["--bending", "≥ 0"],
+    );
+    // Forward Euler diverges on the undamped membrane at the meter's own step; the message
+    // gives that step to four digits, not as 0.00008324200421703758.
+    let out = hooke(
+        &["drape", "cotton", "--integrator", "euler", "--repeats", "1"],
+        &dir,
+    );
+    let said = stderr(&out);
+    let longest_digits = said
+        .split(|c: char| !c.is_ascii_digit())
+        .map(str::len)
+        .max()
+        .unwrap_or(0);
+    assert!(
+        !out.status.success() && said.contains("diverged") && longest_digits <= 6,
+        "{said}"
+    );
     refused(&dir, &["drape", "cotton", "--dt=0"], &["--dt", "above 0"]);
     write(
         &dir,

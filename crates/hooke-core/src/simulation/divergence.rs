@@ -149,7 +149,7 @@ impl Divergence {
     }
 
     fn message(&self) -> String {
-        use crate::Num;
+        use crate::Approx;
         let head = format!(
             "diverged at step {} (t = {} s): particle {} {}",
             self.step,
@@ -174,7 +174,7 @@ impl Divergence {
                  from, which had already run away: look for forces that stiffen as the state \
                  moves (a strong wind, a stiff penalty collider); {} may help",
                 self.integrator,
-                Num(self.dt),
+                Approx(self.dt),
                 self.stable_dt,
                 self.step_stable_dt,
                 self.smaller()
@@ -184,7 +184,7 @@ impl Divergence {
                 "the {} step dt = {} s exceeds its stable estimate of {:.3e} s at the run's start \
                  (as hooke check says){here}; use {} or smaller",
                 self.integrator,
-                Num(self.dt),
+                Approx(self.dt),
                 self.stable_dt,
                 self.smaller()
             )
@@ -200,7 +200,7 @@ impl Divergence {
                  collider, a strong force field or an extreme initial state; a smaller step, \
                  {}, may still help",
                 self.integrator,
-                Num(self.dt),
+                Approx(self.dt),
                 self.smaller()
             )
         };
