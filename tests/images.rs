@@ -357,14 +357,7 @@ fn a_solid_cube_is_drawn_with_flat_faces() {
     let dir = std::env::temp_dir().join(format!("hooke-flat-faces-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let corner = |i: u32| Vec3::new((i >> 2 & 1) as f64, (i >> 1 & 1) as f64, (i & 1) as f64);
-    let quads: [[u32; 4]; 6] = [
-        [0, 1, 3, 2],
-        [4, 6, 7, 5],
-        [0, 4, 5, 1],
-        [2, 3, 7, 6],
-        [0, 2, 6, 4],
-        [1, 5, 7, 3],
-    ];
+    let quads = hooke_collide::BOX_FACES.map(|q| q.map(|k| k as u32));
     let mut obj = String::new();
     for i in 0..8 {
         let p = corner(i) * 0.6;

@@ -103,17 +103,10 @@ mod tests {
         let positions: Vec<Vec3> = (0..8)
             .map(|i| Vec3::new((i >> 2 & 1) as f64, (i >> 1 & 1) as f64, (i & 1) as f64))
             .collect();
-        let quads = [
-            [0, 1, 3, 2],
-            [4, 6, 7, 5],
-            [0, 4, 5, 1],
-            [2, 3, 7, 6],
-            [0, 2, 6, 4],
-            [1, 5, 7, 3],
-        ];
-        let triangles = quads
+        let triangles = hooke_collide::BOX_FACES
             .iter()
-            .flat_map(|q: &[u32; 4]| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .map(|q| q.map(|k| k as u32))
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
             .collect();
         Drawn {
             normals: vec![Vec3::zeros(); 8],
