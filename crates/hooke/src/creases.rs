@@ -5,36 +5,21 @@
 //! within the angle, keeps its vertex normals bit for bit.
 
 use hooke_core::Vec3;
-use hooke_render::Rgb;
+use hooke_render::Mesh;
 
 /// The angle between two faces' normals beyond which the edge between them is drawn hard:
 /// Blender's auto-smooth default is 30°; a deformed lattice's box corner stays near 90°.
 const CREASE: f64 = 45.0;
 
-/// A mesh to draw: positions, a unit normal per position, triangles and per-position
-/// colours (empty for one colour).
-pub(crate) struct Drawn {
-    pub(crate) positions: Vec<Vec3>,
-    pub(crate) normals: Vec<Vec3>,
-    pub(crate) triangles: Vec<[u32; 3]>,
-    pub(crate) colors: Vec<Rgb>,
-}
-
-/// `mesh` with every vertex where faces meet beyond [`CREASE`] split into one copy per
-/// distinct normal of its corners, each corner's normal the area-weighted sum of the
-/// vertex's faces within the angle of its own face.
-pub(crate) fn split(mesh: Drawn) -> Drawn {
-    let Drawn {
-        mut positions,
-        mut normals,
-        mut triangles,
-        mut colors,
-    } = mesh;
-    let x = positions.clone();
-    let face: Vec<Vec3> = triangles
+/// Splits every vertex of `mesh` where faces meet beyond [`CREASE`] into one copy per
+/// distinct normal of its corners (copies appended, with the vertex's colour), each corner's
+/// normal the area-weighted sum of the vertex's faces within the angle of its own face.
+pub(crate) fn split(mesh: &mut Mesh) {
+    let face: Vec<Vec3> = mesh
+        .triangles
         .iter()
         .map(|t| {
-            let [a, b, c] = t.map(|i| x[i as usize]);
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
             (b - a).cross(&(c - a))
         })
         .collect();
@@ -42,8 +27,8 @@ pub(crate) fn split(mesh: Drawn) -> Drawn {
         .iter()
         .map(|n| n.try_normalize(0.0).unwrap_or_else(Vec3::zeros))
         .collect();
-    let mut around: Vec<Vec<(usize, usize)>> = vec![Vec::new(); x.len()];
-    for (t, corners) in triangles.iter().enumerate() {
+    let mut around: Vec<Vec<(usize, usize)>> = vec![Vec::new(); mesh.positions.len()];
+    for (t, corners) in mesh.triangles.iter().enumerate() {
         for (k, &v) in corners.iter().enumerate() {
             around[v as usize].push((t, k));
         }
@@ -69,28 +54,22 @@ pub(crate) fn split(mesh: Drawn) -> Drawn {
                 Some(&(_, i)) => i,
                 None => {
                     let i = if made.is_empty() {
-                        normals[v] = n;
+                        mesh.normals[v] = n;
                         v as u32
                     } else {
-                        positions.push(x[v]);
-                        normals.push(n);
-                        if !colors.is_empty() {
-                            colors.push(colors[v]);
+                        mesh.positions.push(mesh.positions[v]);
+                        mesh.normals.push(n);
+                        if !mesh.colors.is_empty() {
+                            mesh.colors.push(mesh.colors[v]);
                         }
-                        (positions.len() - 1) as u32
+                        (mesh.positions.len() - 1) as u32
                     };
                     made.push((n, i));
                     i
                 }
             };
-            triangles[t][k] = index;
+            mesh.triangles[t][k] = index;
         }
-    }
-    Drawn {
-        positions,
-        normals,
-        triangles,
-        colors,
     }
 }
 
@@ -99,7 +78,7 @@ mod tests {
     use super::*;
 
     /// A unit cube of 12 triangles wound outward.
-    fn cube() -> Drawn {
+    fn cube() -> Mesh {
         let positions: Vec<Vec3> = (0..8)
             .map(|i| Vec3::new((i >> 2 & 1) as f64, (i >> 1 & 1) as f64, (i & 1) as f64))
             .collect();
@@ -108,17 +87,18 @@ mod tests {
             .map(|q| q.map(|k| k as u32))
             .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
             .collect();
-        Drawn {
+        Mesh {
             normals: vec![Vec3::zeros(); 8],
             positions,
             triangles,
-            colors: Vec::new(),
+            ..Mesh::default()
         }
     }
 
     #[test]
     fn a_cube_is_drawn_with_each_face_flat() {
-        let out = split(cube());
+        let mut out = cube();
+        split(&mut out);
         // Three faces meet at each corner: three copies of each.
         assert_eq!(out.positions.len(), 24);
         for t in &out.triangles {
@@ -134,7 +114,7 @@ mod tests {
     fn a_smooth_surface_keeps_its_vertices_and_normals() {
         // A shallow tent of two triangles, 20° apart: no hard edge.
         let lift = 20f64.to_radians().tan() * 0.5;
-        let mesh = Drawn {
+        let mut out = Mesh {
             positions: vec![
                 Vec3::new(0.0, 0.0, 0.0),
                 Vec3::new(1.0, 0.0, 0.0),
@@ -143,9 +123,9 @@ mod tests {
             ],
             normals: vec![Vec3::y(); 4],
             triangles: vec![[0, 2, 1], [0, 1, 3]],
-            colors: Vec::new(),
+            ..Mesh::default()
         };
-        let out = split(mesh);
+        split(&mut out);
         assert_eq!(out.positions.len(), 4);
         assert_eq!(out.normals, vec![Vec3::y(); 4]);
         assert_eq!(out.triangles, vec![[0, 2, 1], [0, 1, 3]]);

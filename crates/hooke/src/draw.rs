@@ -129,24 +129,18 @@ fn skin(list: &mut DrawList, (x, tint): (&[Vec3], Option<&[Rgb]>), body: &Body, 
             })
             .collect()
     });
-    // A solid's box corners are edges, not curves; a cloth's folds stay smooth.
-    let drawn = crate::creases::Drawn {
+    let mut mesh = Mesh {
         positions,
         normals,
         triangles,
+        color,
         colors,
     };
-    let drawn = match body.topology {
-        Topology::Solid => crate::creases::split(drawn),
-        _ => drawn,
-    };
-    list.meshes.push(Mesh {
-        positions: drawn.positions,
-        normals: drawn.normals,
-        triangles: drawn.triangles,
-        color,
-        colors: drawn.colors,
-    });
+    // A solid's box corners are edges, not curves; a cloth's folds stay smooth.
+    if matches!(body.topology, Topology::Solid) {
+        crate::creases::split(&mut mesh);
+    }
+    list.meshes.push(mesh);
 }
 
 fn ground(list: &mut DrawList, height: f64, centre: Vec3, half: f64) {
