@@ -31,6 +31,7 @@ mod error;
 pub mod example_meshes;
 pub mod footprint;
 pub mod generators;
+mod joined;
 mod limits;
 pub mod material;
 mod overlaps;

@@ -3,6 +3,7 @@
 //! as separate pieces). The contacts push them apart in the first steps, which is seldom
 //! what the author meant, so a scene that does is warned about (docs/physics.md §3.4).
 
+use crate::joined::Joined;
 use crate::scene::Scene;
 use hooke_core::{Num, Spring, Vec3};
 use std::collections::{HashMap, HashSet};
@@ -20,16 +21,17 @@ pub(crate) fn overlapping_bodies(scene: &Scene) -> Vec<String> {
                 continue;
             }
             let reach = body.thickness + other.thickness;
-            let within = |range: &std::ops::Range<usize>| {
-                springs
-                    .iter()
-                    .filter(|s| range.contains(&(s.i as usize)) && range.contains(&(s.j as usize)))
-                    .collect::<Vec<_>>()
-            };
             let everywhere = |_: &Spring, _: &[u32; 3]| true;
-            let mut near = hits(x, &within(&body.range), &other.triangles, reach, everywhere);
+            let mut near = hits(
+                x,
+                &within(springs, &body.range),
+                &other.triangles,
+                reach,
+                everywhere,
+            );
             if !body.triangles.is_empty() {
-                near += hits(x, &within(&other.range), &body.triangles, reach, everywhere);
+                let mine = within(springs, &other.range);
+                near += hits(x, &mine, &body.triangles, reach, everywhere);
             }
             if near > 0 {
                 said.push(format!(
@@ -68,12 +70,7 @@ pub(crate) fn overlapping_pieces(scene: &Scene) -> Vec<String> {
             continue;
         }
         let of = |i: u32| piece[i as usize - body.range.start];
-        let mine: Vec<&Spring> = springs
-            .iter()
-            .filter(|s| {
-                body.range.contains(&(s.i as usize)) && body.range.contains(&(s.j as usize))
-            })
-            .collect();
+        let mine = within(springs, &body.range);
         let apart = |s: &Spring, t: &[u32; 3]| of(s.i) != of(t[0]) && of(s.j) != of(t[0]);
         let near = hits(x, &mine, &body.triangles, body.thickness, apart);
         if near > 0 {
@@ -91,31 +88,29 @@ pub(crate) fn overlapping_pieces(scene: &Scene) -> Vec<String> {
     said
 }
 
+/// The springs with both ends in `range` (one body's).
+fn within<'a>(springs: &'a [Spring], range: &std::ops::Range<usize>) -> Vec<&'a Spring> {
+    springs
+        .iter()
+        .filter(|s| range.contains(&(s.i as usize)) && range.contains(&(s.j as usize)))
+        .collect()
+}
+
 /// Each particle of `range` numbered by the piece of `triangles` it belongs to (pieces
 /// joined through shared corners, numbered from 0 in order of their first particle); a
 /// particle in no triangle is its own piece.
 fn pieces(triangles: &[[u32; 3]], range: &std::ops::Range<usize>) -> Vec<usize> {
-    let mut parent: Vec<usize> = (0..range.len()).collect();
-    fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
+    let mut joined = Joined::new(range.len());
     for t in triangles {
-        let [a, b, c] = t.map(|i| i as usize - range.start);
-        for (p, q) in [(a, b), (b, c)] {
-            let (rp, rq) = (root(&mut parent, p), root(&mut parent, q));
-            parent[rp.max(rq)] = rp.min(rq);
-        }
+        let [a, b, c] = t.map(|i| (i as usize - range.start) as u32);
+        joined.join(a, b);
+        joined.join(b, c);
     }
     let mut number = HashMap::new();
-    (0..range.len())
+    (0..range.len() as u32)
         .map(|i| {
-            let r = root(&mut parent, i);
             let next = number.len();
-            *number.entry(r).or_insert(next)
+            *number.entry(joined.root(i)).or_insert(next)
         })
         .collect()
 }

@@ -3,6 +3,7 @@
 //! file's vertices to the particles that the outputs use to hand them back in order.
 
 use crate::error::{BuildError, invalid};
+use crate::joined::Joined;
 use crate::skin::{Skin, SkinVertex};
 use hooke_collide::PolygonMesh;
 use hooke_core::{Num, Vec3};
@@ -292,15 +293,7 @@ pub(crate) fn bounds_diagonal(x: &[Vec3]) -> f64 {
 /// Each vertex's representative: the lowest-numbered vertex within `d` of it, through any
 /// chain of such neighbours (found on a grid of cells `d` wide).
 fn weld_by_distance(x: &[Vec3], d: f64) -> Vec<u32> {
-    let mut parent: Vec<u32> = (0..x.len() as u32).collect();
-    fn root(parent: &mut [u32], mut i: u32) -> u32 {
-        while parent[i as usize] != i {
-            let p = parent[i as usize];
-            parent[i as usize] = parent[p as usize];
-            i = p;
-        }
-        i
-    }
+    let mut welded = Joined::new(x.len());
     let cell = |p: &Vec3| (p / d).map(|c| c.floor() as i64);
     let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
     for (i, p) in x.iter().enumerate() {
@@ -313,9 +306,7 @@ fn weld_by_distance(x: &[Vec3], d: f64) -> Vec<u32> {
                     };
                     for &j in near {
                         if (x[j as usize] - p).norm() <= d {
-                            let (a, b) = (root(&mut parent, i as u32), root(&mut parent, j));
-                            let (lo, hi) = (a.min(b), a.max(b));
-                            parent[hi as usize] = lo;
+                            welded.join(i as u32, j);
                         }
                     }
                 }
@@ -323,5 +314,5 @@ fn weld_by_distance(x: &[Vec3], d: f64) -> Vec<u32> {
         }
         grid.entry([c.x, c.y, c.z]).or_default().push(i as u32);
     }
-    (0..x.len() as u32).map(|i| root(&mut parent, i)).collect()
+    (0..x.len() as u32).map(|i| welded.root(i)).collect()
 }
