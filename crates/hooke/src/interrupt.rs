@@ -100,25 +100,23 @@ pub fn requested() -> bool {
 /// Between two steps of `simulation`: an [`Interrupted`] error saying where it stopped, if
 /// an interrupt arrived.
 pub fn check(simulation: &hooke_core::Simulation) -> Result<(), Interrupted> {
-    if requested() {
-        Err(Interrupted {
-            step: simulation.steps(),
-            time: simulation.time(),
-        })
-    } else {
-        Ok(())
-    }
+    stopped_at(simulation.steps(), simulation.time())
 }
 
 /// Just after a step of `simulation`: an [`Interrupted`] error, if an interrupt arrived,
 /// that counts the step as not completed (an iterative step ends early at an interrupt,
 /// `Simulation::set_cancel`, so its state is not one to write or measure).
 pub fn check_after_step(simulation: &hooke_core::Simulation) -> Result<(), Interrupted> {
+    stopped_at(
+        simulation.steps().saturating_sub(1),
+        (simulation.time() - simulation.dt()).max(0.0),
+    )
+}
+
+/// An [`Interrupted`] at `step` and `time` if an interrupt arrived.
+fn stopped_at(step: u64, time: f64) -> Result<(), Interrupted> {
     if requested() {
-        Err(Interrupted {
-            step: simulation.steps().saturating_sub(1),
-            time: (simulation.time() - simulation.dt()).max(0.0),
-        })
+        Err(Interrupted { step, time })
     } else {
         Ok(())
     }
