@@ -42,7 +42,10 @@ impl Simulation {
         loop {
             parts += 1;
             let span = if parts < PART_BUDGET {
-                self.part((t, end), least).max(least)
+                // The rest of the step in equal parts no longer than the collider allows, so
+                // that no sliver of a part is left at its end.
+                let most = self.part((t, end), least).max(least);
+                (end - t) / ((end - t) / most).ceil().max(1.0)
             } else {
                 end - t
             };
