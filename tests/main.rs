@@ -5,12 +5,14 @@
 
 mod air;
 mod bodies;
+mod caches;
 mod cancel;
 mod collisions;
 mod common;
 mod conservation;
 mod contact;
 mod creases;
+mod deforming;
 mod determinism;
 mod drape;
 mod face_order;

@@ -49,7 +49,7 @@ fn expected(x: Vec3, c: Vec3, t: f64) -> Vec3 {
 /// `hanging-cloth` (two corners pinned) with the test's keys, under `integrator` at `dt`.
 fn carried(integrator: Integrator, dt: f64) -> Scene {
     let mut spec = hooke_scene::builtin::builtin("hanging-cloth").unwrap();
-    spec.bodies[0].pin_motion = Some(MotionSpec { keys: keys() });
+    spec.bodies[0].pin_motion = Some(MotionSpec::of_keys(keys()));
     let overrides = Overrides {
         integrator: Some(integrator),
         dt: Some(dt),
@@ -121,12 +121,10 @@ fn keyframed_pins_sit_at_their_keys_at_every_step_and_carry_the_cloth() {
 #[test]
 fn a_cloth_lifted_30_m_by_its_pins_follows_them_under_block_descent() {
     let mut spec = hooke_scene::builtin::builtin("hanging-cloth").unwrap();
-    spec.bodies[0].pin_motion = Some(MotionSpec {
-        keys: vec![
-            key(0.5, [0.0, 0.0, 0.0], None),
-            key(1.5, [0.0, 30.0, 0.0], None),
-        ],
-    });
+    spec.bodies[0].pin_motion = Some(MotionSpec::of_keys(vec![
+        key(0.5, [0.0, 0.0, 0.0], None),
+        key(1.5, [0.0, 30.0, 0.0], None),
+    ]));
     spec.simulation.duration = Some(hooke_scene::spec::Positive::of(4.0));
     let overrides = Overrides {
         integrator: Some(Integrator::Vbd),
@@ -155,7 +153,7 @@ fn centroid(scene: &Scene) -> Vec3 {
 #[test]
 fn pin_motions_without_pins_or_in_the_wrong_order_are_refused() {
     let mut spec = hooke_scene::builtin::builtin("hanging-cloth").unwrap();
-    spec.bodies[0].pin_motion = Some(MotionSpec { keys: keys() });
+    spec.bodies[0].pin_motion = Some(MotionSpec::of_keys(keys()));
     spec.bodies[0].pins = Default::default();
     let e = spec
         .build(&root().join("assets/scenes"))
@@ -165,7 +163,7 @@ fn pin_motions_without_pins_or_in_the_wrong_order_are_refused() {
     let mut spec = hooke_scene::builtin::builtin("hanging-cloth").unwrap();
     let mut keys = keys();
     keys.swap(0, 2);
-    spec.bodies[0].pin_motion = Some(MotionSpec { keys });
+    spec.bodies[0].pin_motion = Some(MotionSpec::of_keys(keys));
     let e = spec
         .build(&root().join("assets/scenes"))
         .unwrap_err()
@@ -249,9 +247,10 @@ fn sliding_table(run: Option<(Integrator, f64)>) -> Scene {
         ..Overrides::default()
     };
     overrides.apply(&mut spec).unwrap();
-    spec.colliders[1].motion = Some(MotionSpec {
-        keys: vec![key(1.5, [0.0; 3], None), key(2.5, [0.3, 0.0, 0.0], None)],
-    });
+    spec.colliders[1].motion = Some(MotionSpec::of_keys(vec![
+        key(1.5, [0.0; 3], None),
+        key(2.5, [0.3, 0.0, 0.0], None),
+    ]));
     spec.build(&root().join("assets/scenes")).unwrap()
 }
 

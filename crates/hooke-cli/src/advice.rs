@@ -181,7 +181,7 @@ pub(crate) fn large_step_promises(scene: &Scene, integrator: Integrator) -> Vec<
     }
     if scene.has_moving_colliders() || !model.pin_motions.is_empty() {
         out.push(format!(
-            "a moving collider or keyed pins are followed in parts of the step, down to dt/{}; \
+            "a moving or deforming collider or moving pins are followed in parts of the step, down to dt/{}; \
              where a pinned or squeezed particle lies in a moving collider's path no integrator \
              can keep the bound, and the run warns at the step it happens",
             hooke_core::MOST_PARTS
@@ -189,7 +189,7 @@ pub(crate) fn large_step_promises(scene: &Scene, integrator: Integrator) -> Vec<
     }
     out.push(
         "a run whose energy grows by more than a hundredth of its scale beyond the work done \
-         on it (field, air, attachments, keyed pins, moving colliders) stops as diverged"
+         on it (field, air, attachments, moving pins, moving colliders) stops as diverged"
             .to_string(),
     );
     out
@@ -202,7 +202,7 @@ pub(crate) fn newton_cost(scene: &Scene) -> Option<String> {
     let moving = scene.has_moving_colliders() || !model.pin_motions.is_empty();
     let surfaces = scene.bodies.iter().any(|b| b.thickness > 0.0);
     (moving && surfaces).then(|| {
-        "newton with a moving collider or keyed pins takes every part of a split step (up to \
+        "newton with a moving collider or moving pins takes every part of a split step (up to \
          4096 a step) as a global solve with a fresh detection: about twice block descent's \
          time where a collider sweeps slowly through a cloth, and 70 times where a fast one \
          splits steps into hundreds of parts (a ball thrown through a hanging cloth at 30 m/s: \

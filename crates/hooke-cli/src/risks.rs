@@ -96,7 +96,21 @@ impl Tunnelling {
 /// The fastest that any point of collider `k` moves along its keys, m/s (zero when it does
 /// not move): per pair of keys, the translation's speed plus the turn's rate (the angles'
 /// change, in radians, summed as a bound) times the farthest point's distance from the pivot.
+/// A mesh its cache deforms: the fastest any vertex moves between two samples.
 fn collider_speed(scene: &Scene, k: usize) -> f64 {
+    if let Some(Some(animation)) = scene.animations.get(k) {
+        let cache = animation.cache();
+        return (1..cache.len())
+            .flat_map(|s| {
+                cache
+                    .sample(s - 1)
+                    .iter()
+                    .zip(cache.sample(s))
+                    .map(|(a, b)| (b - a).norm())
+            })
+            .fold(0.0, f64::max)
+            / cache.interval();
+    }
     let Some(keys) = scene.spec.colliders[k]
         .motion
         .as_ref()

@@ -11,6 +11,7 @@
 //! | analytic cylinder tabletop | [`Cylinder`] | within the disc |
 //! | ball | [`Sphere`] | nearer the centre than the radius |
 //! | triangle mesh (OBJ) | [`TriMeshCollider`] | inside a closed part, or crossed in a step |
+//! | deforming mesh (OBJ + PC2) | [`DeformingMesh`] | as a mesh, on the cache's positions now |
 //!
 //! Planes, the box, the cylinder and the ball are closed-form (the contract's formulas as written);
 //! meshes use parry3d-f64's BVH, point projection with pseudo-normals and ray casts, and are
@@ -29,21 +30,27 @@
 
 mod bounds;
 mod box_interior;
+mod cache;
 mod cylinder;
+mod deforming;
 mod obj;
 mod plane;
 mod polygons;
+mod shells;
 mod sphere;
 pub mod table;
 mod trimesh;
 
 pub use box_interior::{BOX_FACES, BoxInterior};
+pub use cache::VertexCache;
 pub use cylinder::Cylinder;
+pub use deforming::DeformingMesh;
 pub use obj::{MeshError, MeshPart, Placement, load_obj, parse_obj};
 pub use plane::Plane;
 pub use polygons::{Polygon, PolygonMesh};
+pub use shells::{closedness_defect, signed_volume};
 pub use sphere::Sphere;
-pub use trimesh::{TriMeshCollider, closedness_defect, signed_volume};
+pub use trimesh::TriMeshCollider;
 
 use std::path::Path;
 

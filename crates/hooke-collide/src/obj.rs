@@ -112,6 +112,14 @@ pub enum MeshError {
         /// What is wrong.
         detail: String,
     },
+    /// A vertex cache (PC2) that cannot animate its mesh.
+    #[error("{path}: {reason}")]
+    Cache {
+        /// The file.
+        path: PathBuf,
+        /// What was expected.
+        reason: String,
+    },
     /// parry could not build the mesh.
     #[error("{path}: object '{part}': {reason}")]
     Build {

@@ -3,10 +3,11 @@
 
 use crate::bounds::{boxes_meet, touch_reach};
 use crate::obj::{MeshError, MeshPart};
+use crate::shells::{closedness_defect, outward};
 use hooke_core::{Collider, Contact, Feature, Vec3};
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector as PVec;
-use parry3d_f64::query::{PointQuery, Ray, RayCast};
+use parry3d_f64::query::{PointQuery, PointQueryWithLocation, Ray, RayCast};
 use parry3d_f64::shape::{TriMesh as ParryMesh, TriMeshFlags};
 use std::collections::HashMap;
 use std::path::Path;
@@ -55,100 +56,6 @@ fn from_parry(v: PVec) -> Vec3 {
     Vec3::new(v.x, v.y, v.z)
 }
 
-/// One id per distinct position: OBJ files repeat vertices per face group, and the
-/// copies of one corner must count as one.
-fn welded(vertices: &[Vec3]) -> Vec<u32> {
-    let mut weld: HashMap<[u64; 3], u32> = HashMap::new();
-    vertices
-        .iter()
-        .map(|v| {
-            let key = [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
-            let next = weld.len() as u32;
-            *weld.entry(key).or_insert(next)
-        })
-        .collect()
-}
-
-/// The volume a closed, consistently oriented surface encloses (the divergence theorem):
-/// positive when its faces wind counter-clockwise seen from outside, negative when the
-/// surface is inside out.
-pub fn signed_volume(vertices: &[Vec3], triangles: &[[u32; 3]]) -> f64 {
-    triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| vertices[i as usize]);
-            a.dot(&b.cross(&c)) / 6.0
-        })
-        .sum()
-}
-
-/// `triangles`, a closed, consistently oriented surface, with every shell (triangles
-/// joined through shared corners) that encloses a negative volume turned outward, its
-/// triangles' winding reversed. Exporters write inside-out solids now and then (flipped
-/// normals); read as they are, everything outside such a table would be inside it, and a
-/// cloth above it would be pulled through its top.
-fn outward(vertices: &[Vec3], mut triangles: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
-    let ids = welded(vertices);
-    // Union-find over welded corners.
-    let mut parent: Vec<u32> = (0..ids.len() as u32).collect();
-    fn root(parent: &mut [u32], mut k: u32) -> u32 {
-        while parent[k as usize] != k {
-            parent[k as usize] = parent[parent[k as usize] as usize];
-            k = parent[k as usize];
-        }
-        k
-    }
-    for t in &triangles {
-        let a = root(&mut parent, ids[t[0] as usize]);
-        for &i in &t[1..] {
-            let b = root(&mut parent, ids[i as usize]);
-            parent[b as usize] = a;
-        }
-    }
-    let shell: Vec<u32> = triangles
-        .iter()
-        .map(|t| root(&mut parent, ids[t[0] as usize]))
-        .collect();
-    let mut volume: HashMap<u32, f64> = HashMap::new();
-    for (t, &s) in triangles.iter().zip(&shell) {
-        *volume.entry(s).or_default() += signed_volume(vertices, std::slice::from_ref(t));
-    }
-    for (t, s) in triangles.iter_mut().zip(&shell) {
-        if volume[s] < 0.0 {
-            t.swap(1, 2);
-        }
-    }
-    triangles
-}
-
-/// Why a part is not a closed, consistently oriented surface, if it is not: every directed
-/// edge must appear once and its reverse once.
-pub fn closedness_defect(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Option<String> {
-    let ids = welded(vertices);
-    let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
-    for t in triangles {
-        for k in 0..3 {
-            let (a, b) = (ids[t[k] as usize], ids[t[(k + 1) % 3] as usize]);
-            *edges.entry((a, b)).or_default() += 1;
-        }
-    }
-    let mut sorted: Vec<_> = edges.iter().collect();
-    sorted.sort();
-    for (&(a, b), &count) in sorted {
-        if count > 1 {
-            return Some(format!(
-                "edge {a}-{b} is used {count} times in the same direction"
-            ));
-        }
-        if !edges.contains_key(&(b, a)) {
-            return Some(format!(
-                "edge {a}-{b} has no opposite: the surface has a hole"
-            ));
-        }
-    }
-    None
-}
-
 impl TriMeshCollider {
     /// Builds a collider from mesh parts. With `require_closed`, an open part is an error.
     pub fn new(
@@ -157,7 +64,30 @@ impl TriMeshCollider {
         path: &Path,
         require_closed: bool,
     ) -> Result<Self, MeshError> {
-        let label = label.into();
+        let flags =
+            TriMeshFlags::MERGE_DUPLICATE_VERTICES | TriMeshFlags::DELETE_DEGENERATE_TRIANGLES;
+        Self::built(label.into(), parts, path, require_closed, flags)
+    }
+
+    /// A collider whose parts keep their vertices and triangles as given (no corner is
+    /// merged, no triangle dropped; a closed shell's triangles may be turned outward), so
+    /// that [`TriMeshCollider::locate`] names a part's own vertices: a mesh whose vertices
+    /// move, built anew for each pose. The parts' corners must already be welded.
+    pub(crate) fn exact(
+        label: String,
+        parts: Vec<MeshPart>,
+        path: &Path,
+    ) -> Result<Self, MeshError> {
+        Self::built(label, parts, path, false, TriMeshFlags::empty())
+    }
+
+    fn built(
+        label: String,
+        parts: Vec<MeshPart>,
+        path: &Path,
+        require_closed: bool,
+        base: TriMeshFlags,
+    ) -> Result<Self, MeshError> {
         let mut built = Vec::with_capacity(parts.len());
         for part in parts {
             let defect = closedness_defect(&part.vertices, &part.triangles);
@@ -193,8 +123,7 @@ impl TriMeshCollider {
                     ),
                 });
             }
-            let mut flags =
-                TriMeshFlags::MERGE_DUPLICATE_VERTICES | TriMeshFlags::DELETE_DEGENERATE_TRIANGLES;
+            let mut flags = base;
             if closed {
                 flags |= TriMeshFlags::ORIENTED;
             }
@@ -224,6 +153,29 @@ impl TriMeshCollider {
             label,
             parts: built,
         })
+    }
+
+    /// The surface point nearest `p`: its part, the corners (the part's vertex indices)
+    /// of the triangle it lies on and its barycentric weights there. `None` for a point
+    /// that is not finite.
+    pub(crate) fn locate(&self, p: &Vec3) -> Option<(usize, [u32; 3], [f64; 3])> {
+        let q = to_parry(p);
+        let mut best: Option<(f64, usize, [u32; 3], [f64; 3])> = None;
+        for (k, part) in self.parts.iter().enumerate() {
+            // A part's box farther than the best so far holds no nearer point.
+            if best.is_some_and(|(d, ..)| part.aabb.distance_to_local_point(q, true) > d) {
+                continue;
+            }
+            let (proj, (t, location)) = part.mesh.project_local_point_and_get_location(q, false);
+            let d = (from_parry(proj.point) - p).norm();
+            if !d.is_finite() || best.is_some_and(|(b, ..)| d >= b) {
+                continue;
+            }
+            let corners = part.mesh.indices()[t as usize];
+            let weights = location.barycentric_coordinates().unwrap_or([1.0 / 3.0; 3]);
+            best = Some((d, k, corners, weights));
+        }
+        best.map(|(_, k, corners, weights)| (k, corners, weights))
     }
 
     /// Number of parts (objects).
@@ -506,6 +458,7 @@ fn has_area(vertices: &[Vec3], triangles: &[[u32; 3]]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::shells::signed_volume;
 
     /// A unit cube from the origin, its faces wound outward, as two shells when `two`
     /// (the second 2 m along x).

@@ -64,7 +64,7 @@ pub use forces::field::ForceField;
 pub use forces::spring::{Spring, SpringKind};
 pub use integrator::{Integrator, SolveTimes, StopRule, UnknownIntegrator};
 pub use keyframes::{Key, KeyError, Keyframes};
-pub use model::motion::PinMotion;
+pub use model::motion::{PinMotion, PinPath};
 pub use model::surface::{DEFAULT_CLOTH_THICKNESS, DEFAULT_SURFACE_FRICTION, Surface};
 pub use model::{Attachment, ColliderSlot, Model};
 pub use number::{Approx, Num};

@@ -1,4 +1,5 @@
-//! Reading a user's text file (a scene, a mesh, a material, a `.w` world) as they have it:
+//! Reading a user's text file (a scene, a mesh, a material, a `.w` world) as they have it
+//! (and a binary input, a vertex cache, by the same rules):
 //! a regular file only, of a size a text input can have, with a UTF-8 byte-order mark (as
 //! Windows editors write) skipped and a byte that is not UTF-8 named by its line. Every
 //! input reader of the workspace goes through [`read_text`], so that a device, a pipe or a
@@ -51,24 +52,7 @@ fn kind(meta: &std::fs::Metadata) -> &'static str {
 /// assert!(e.to_string().contains("a character device"), "{e}");
 /// ```
 pub fn read_text(path: &Path) -> std::io::Result<String> {
-    let meta = std::fs::metadata(path)?;
-    if !meta.is_file() {
-        return Err(Error::new(
-            ErrorKind::InvalidInput,
-            format!("{}, not a regular file (expected a text file)", kind(&meta)),
-        ));
-    }
-    if meta.len() > MOST_TEXT_BYTES {
-        return Err(too_large(meta.len()));
-    }
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    // The file may have grown since: never read past the bound.
-    std::fs::File::open(path)?
-        .take(MOST_TEXT_BYTES + 1)
-        .read_to_end(&mut bytes)?;
-    if bytes.len() as u64 > MOST_TEXT_BYTES {
-        return Err(too_large(bytes.len() as u64));
-    }
+    let bytes = read_regular(path, "a text file")?;
     match String::from_utf8(bytes) {
         Ok(mut text) => {
             if text.starts_with(BOM) {
@@ -93,11 +77,47 @@ pub fn read_text(path: &Path) -> std::io::Result<String> {
     }
 }
 
+/// The bytes of the regular file at `path` (a binary input: a vertex cache), refused as
+/// [`read_text`] refuses a folder, a device, a pipe or a file over 1 GiB, before anything is
+/// read.
+///
+/// ```
+/// let e = hooke_core::text::read_bytes(std::path::Path::new("/dev/zero")).unwrap_err();
+/// assert!(e.to_string().contains("a character device"), "{e}");
+/// ```
+pub fn read_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
+    read_regular(path, "a file")
+}
+
+/// The bytes of the regular file at `path`, at most [`MOST_TEXT_BYTES`]; `expected` names
+/// what it should have been in the error for anything else.
+fn read_regular(path: &Path, expected: &str) -> std::io::Result<Vec<u8>> {
+    let meta = std::fs::metadata(path)?;
+    if !meta.is_file() {
+        return Err(Error::new(
+            ErrorKind::InvalidInput,
+            format!("{}, not a regular file (expected {expected})", kind(&meta)),
+        ));
+    }
+    if meta.len() > MOST_TEXT_BYTES {
+        return Err(too_large(meta.len()));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    // The file may have grown since: never read past the bound.
+    std::fs::File::open(path)?
+        .take(MOST_TEXT_BYTES + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MOST_TEXT_BYTES {
+        return Err(too_large(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
 fn too_large(len: u64) -> Error {
     Error::new(
         ErrorKind::InvalidInput,
         format!(
-            "{len} bytes is more than the {} MiB a text input may have",
+            "{len} bytes is more than the {} MiB an input may have",
             MOST_TEXT_BYTES >> 20
         ),
     )

@@ -434,9 +434,10 @@ pub fn puck_sweep() -> SceneSpec {
             cr: Fraction::of(0.0),
             friction: NonNegative::of(0.3),
         },
-        motion: Some(MotionSpec {
-            keys: vec![key(2.0, 0.0, 0.0), key(4.0, 2.5, 90.0)],
-        }),
+        motion: Some(MotionSpec::of_keys(vec![
+            key(2.0, 0.0, 0.0),
+            key(4.0, 2.5, 90.0),
+        ])),
     });
     spec
 }

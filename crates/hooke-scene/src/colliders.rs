@@ -69,7 +69,8 @@ pub fn mesh_text(path: &str, base: &Path) -> Result<(String, PathBuf), MeshError
 }
 
 /// `shape` moved by `motion` about its pivot: a mesh's placed origin (`translate`), a
-/// box's, a cylinder's or a sphere's centre. A ground or a plane cannot move.
+/// box's, a cylinder's or a sphere's centre. A ground or a plane cannot move. A motion
+/// with a `cache` is a mesh's vertex animation ([`deforming`]), built there instead.
 pub(crate) fn moving(
     shape: Box<dyn Collider>,
     spec: &ColliderShapeSpec,
@@ -87,14 +88,100 @@ pub(crate) fn moving(
 }
 
 /// The keys of the motion at `key` (a collider's `motion`, a body's `pin_motion`), checked;
-/// a bad one is refused as `key.keys`.
+/// a bad one is refused as `key.keys`, and a motion that gives `cache` as well, or
+/// `fps` without it, by those keys.
 pub(crate) fn keyframes(
     motion: &crate::spec::MotionSpec,
     key: &str,
 ) -> Result<hooke_core::Keyframes, BuildError> {
+    if motion.cache.is_some() && !motion.keys.is_empty() {
+        return Err(invalid(
+            format!("{key}.cache"),
+            "a motion follows `keys` or a `cache`, not both: remove one",
+        ));
+    }
+    if motion.fps.is_some() && motion.cache.is_none() {
+        return Err(invalid(
+            format!("{key}.fps"),
+            "`fps` is the frame rate of a `cache`, and this motion has none: give `cache` \
+             or remove `fps`",
+        ));
+    }
     motion
         .keyframes()
         .map_err(|e| invalid(format!("{key}.keys"), e.to_string()))
+}
+
+/// A cache's path and frame rate, checked: a motion with a `cache` must give its `fps`
+/// and no `keys`.
+pub(crate) fn cache_of<'a>(
+    motion: &'a crate::spec::MotionSpec,
+    key: &str,
+) -> Result<Option<(&'a str, f64)>, BuildError> {
+    let Some(cache) = &motion.cache else {
+        return Ok(None);
+    };
+    if !motion.keys.is_empty() {
+        return Err(invalid(
+            format!("{key}.cache"),
+            "a motion follows `keys` or a `cache`, not both: remove one",
+        ));
+    }
+    let Some(fps) = motion.fps else {
+        return Err(invalid(
+            format!("{key}.fps"),
+            "missing: a `cache` needs the frame rate it was written at, e.g. `fps = 24.0` \
+             (Blender: Output Properties, Frame Rate)",
+        ));
+    };
+    Ok(Some((cache.as_str(), fps.get())))
+}
+
+/// A mesh collider animated by the vertex cache at `cache` (relative to `base`), played at
+/// `fps`: the mesh is read as written (every vertex in the file's order, which the cache
+/// follows) and placed as the scene places it.
+pub(crate) fn deforming(
+    spec: &ColliderShapeSpec,
+    (cache, fps): (&str, f64),
+    key: &str,
+    base: &Path,
+) -> Result<hooke_collide::DeformingMesh, BuildError> {
+    let ColliderShapeSpec::Mesh {
+        path,
+        translate,
+        rotate,
+        scale,
+    } = spec
+    else {
+        return Err(invalid(
+            format!("{key}.motion.cache"),
+            "only a mesh collider can deform: give `shape.kind = \"mesh\"` with the OBJ the \
+             cache animates, or move this shape with `keys`",
+        ));
+    };
+    let placement = Placement {
+        translate: vec3(translate),
+        rotate: vec3(rotate),
+        scale: Vec3::new(scale[0].get(), scale[1].get(), scale[2].get()),
+    };
+    let mesh_error = |name: &str| {
+        let key = format!("{key}.{name}");
+        move |source| BuildError::Mesh { key, source }
+    };
+    let (text, full) = mesh_text(path, base).map_err(mesh_error("shape.path"))?;
+    let mesh = hooke_collide::PolygonMesh::parse(&text, &full, crate::limits::MAX_PARTICLES)
+        .map_err(mesh_error("shape.path"))?;
+    let at = base.join(cache);
+    let frames = hooke_collide::VertexCache::read(&at, mesh.positions.len(), fps, &placement)
+        .map_err(mesh_error("motion.cache"))?;
+    hooke_collide::DeformingMesh::new(
+        format!("deforming mesh {path}"),
+        &mesh,
+        &placement,
+        frames,
+        &at,
+    )
+    .map_err(mesh_error("motion.cache"))
 }
 
 pub(crate) fn build_collider(
@@ -213,6 +300,22 @@ impl SceneSpec {
                     }
                     _ => None,
                 });
-        bodies.chain(colliders).collect()
+        let caches = self
+            .colliders
+            .iter()
+            .enumerate()
+            .filter_map(|(c, collider)| {
+                let cache = collider.motion.as_ref()?.cache.as_ref()?;
+                Some((format!("collider[{c}].motion.cache"), base.join(cache)))
+            });
+        let pin_caches = self.bodies.iter().enumerate().filter_map(|(b, body)| {
+            let cache = body.pin_motion.as_ref()?.cache.as_ref()?;
+            Some((format!("body[{b}].pin_motion.cache"), base.join(cache)))
+        });
+        bodies
+            .chain(colliders)
+            .chain(caches)
+            .chain(pin_caches)
+            .collect()
     }
 }

@@ -135,8 +135,13 @@ pub struct Scene {
     pub every: u64,
     /// The bodies.
     pub bodies: Vec<Body>,
-    /// Collider geometry, in the order of the scene file.
+    /// Collider geometry, in the order of the scene file (a deforming mesh as it is at the
+    /// start).
     pub colliders: Vec<ColliderGeometry>,
+    /// Per collider, in the same order, the vertex animation of a mesh its cache deforms
+    /// (`motion = { cache, fps }`), for drawing it where it is: see
+    /// [`Scene::collider_triangles_at`].
+    pub animations: Vec<Option<std::sync::Arc<hooke_collide::DeformingMesh>>>,
     /// The particles moved out of velocity-level colliders before the first step, per
     /// collider (see [`hooke_core::Simulation::push_out_start`]); said as warnings.
     pub pushed_out: Vec<hooke_core::PushedOut>,
@@ -166,6 +171,11 @@ impl ColliderPose {
 }
 
 impl Scene {
+    /// The triangles of collider `k` at time `t` when a cache deforms it, or `None`.
+    pub fn collider_triangles_at(&self, k: usize, t: f64) -> Option<Vec<[Vec3; 3]>> {
+        Some(self.animations.get(k)?.as_ref()?.triangles_at(t))
+    }
+
     /// The pose of collider `k` at time `t` (seconds), or `None` when it does not move.
     pub fn collider_pose(&self, k: usize, t: f64) -> Option<ColliderPose> {
         let spec = self.spec.colliders.get(k)?;

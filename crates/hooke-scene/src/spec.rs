@@ -489,12 +489,22 @@ pub struct SpringsSpec {
     pub pairs: Vec<PairSpec>,
 }
 
-/// `[body.pin_motion]` (and later colliders' motions): `keys = [{ t, translate, rotate }, …]`.
+/// `[body.pin_motion]` and a collider's `motion`: rigid keys,
+/// `keys = [{ t, translate, rotate }, …]`, or, for a mesh collider, a vertex animation,
+/// `cache = "arm.pc2"` (PC2, a point per vertex of the mesh in the file's order) with
+/// `fps = 24.0`, its frames per second.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MotionSpec {
     /// The keys, in increasing time.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub keys: Vec<KeySpec>,
+    /// A PC2 vertex cache animating a mesh collider, relative to the scene file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cache: Option<String>,
+    /// The cache's frames per second: sample `k` is at `k · sampling / fps` seconds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fps: Option<Positive>,
 }
 
 /// One key of a motion.
@@ -525,6 +535,15 @@ impl ColliderShapeSpec {
 }
 
 impl MotionSpec {
+    /// A motion by `keys` (no cache).
+    pub fn of_keys(keys: Vec<KeySpec>) -> Self {
+        Self {
+            keys,
+            cache: None,
+            fps: None,
+        }
+    }
+
     /// The keys as the core's, checked (at least one, times increasing).
     pub fn keyframes(&self) -> Result<hooke_core::Keyframes, hooke_core::KeyError> {
         hooke_core::Keyframes::new(

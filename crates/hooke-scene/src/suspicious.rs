@@ -82,6 +82,7 @@ impl Scene {
                 ));
             }
         }
+        said.extend(self.caches_away_or_short());
         said.extend(self.pins_into_colliders());
         said.extend(self.ignored_stop_rule());
         for moved in &self.pushed_out {
@@ -140,6 +141,69 @@ impl Scene {
         said
     }
 
+    /// Caches that start away or end early: pins whose cache's first sample is not where
+    /// they start (they jump there at the first step and pull the body after them), and
+    /// caches whose last sample comes before the run ends (their mesh or pins hold there).
+    fn caches_away_or_short(&self) -> Vec<String> {
+        let mut said = Vec::new();
+        let model = self.simulation.model();
+        let end = self.steps as f64 * self.simulation.dt();
+        let x = &self.simulation.particles().x;
+        for motion in &model.pin_motions {
+            if !matches!(motion.path, hooke_core::PinPath::Track { .. }) {
+                continue;
+            }
+            let away = motion
+                .positions(0.0)
+                .map(|(i, at)| (at - x[i]).norm())
+                .fold(0.0, f64::max);
+            let b = self.bodies.iter().position(|b| {
+                motion
+                    .particles
+                    .first()
+                    .is_some_and(|&i| b.range.contains(&(i as usize)))
+            });
+            if let Some(b) = b
+                && away > 1e-6
+            {
+                said.push(format!(
+                    "body[{b}] '{}': its pin_motion cache puts a pin {} m from where it starts \
+                     at t = 0, so the pins jump there at the first step and pull the body after \
+                     them; write the cache from the body's own vertices (sample 0 where they \
+                     are) or place the body on it",
+                    self.bodies[b].name,
+                    hooke_core::Approx(away)
+                ));
+            }
+            let last = motion.times().last().copied().unwrap_or(0.0);
+            if let Some(b) = b
+                && last < end - 1e-9
+            {
+                said.push(format!(
+                    "body[{b}] '{}': its pin_motion cache ends at t = {} s and the run at {} s: \
+                     the pins hold their last sample from then on",
+                    self.bodies[b].name,
+                    hooke_core::Approx(last),
+                    hooke_core::Approx(end)
+                ));
+            }
+        }
+        for (k, animation) in self.animations.iter().enumerate() {
+            if let Some(a) = animation
+                && a.cache().duration() < end - 1e-9
+            {
+                said.push(format!(
+                    "collider[{k}] ({}): its cache ends at t = {} s and the run at {} s: the \
+                     mesh holds its last sample from then on",
+                    model.colliders[k].shape.name(),
+                    hooke_core::Approx(a.cache().duration()),
+                    hooke_core::Approx(end)
+                ));
+            }
+        }
+        said
+    }
+
     /// Keyed pins that their keys take into a still collider: they drag their body in after
     /// them, which no integrator prevents (a pin is moved by its keys, not by contacts).
     /// Sampled at every key and at 64 times between two keys.
@@ -148,14 +212,13 @@ impl Scene {
         let model = self.simulation.model();
         let mut said = Vec::new();
         for motion in &model.pin_motions {
-            let keys = motion.keys.keys();
-            let times: Vec<f64> = keys
+            let turns = motion.times();
+            let times: Vec<f64> = turns
                 .windows(2)
                 .flat_map(|w| {
-                    (0..SAMPLES)
-                        .map(move |k| w[0].t + (w[1].t - w[0].t) * k as f64 / SAMPLES as f64)
+                    (0..SAMPLES).map(move |k| w[0] + (w[1] - w[0]) * k as f64 / SAMPLES as f64)
                 })
-                .chain(keys.last().map(|k| k.t))
+                .chain(turns.last().copied())
                 .filter(|t| *t >= 0.0)
                 .collect();
             'colliders: for (k, slot) in model.colliders.iter().enumerate() {
@@ -170,9 +233,9 @@ impl Scene {
                             .find(|b| b.range.contains(&i))
                             .map_or(String::new(), |b| format!(" of body '{}'", b.name));
                         said.push(format!(
-                            "the keyed pins{body} enter collider[{k}] ({}) by t = {} s: a pin \
-                             follows its keys whatever is in its way, and drags its body into \
-                             the collider after it under every integrator; key the pins clear \
+                            "the moving pins{body} enter collider[{k}] ({}) by t = {} s: a pin \
+                             follows its motion whatever is in its way, and drags its body into \
+                             the collider after it under every integrator; move the pins clear \
                              of it",
                             slot.shape.name(),
                             hooke_core::Approx(t)

@@ -342,6 +342,10 @@ pub fn draw_tinted(
     let t = scene.simulation.time();
     for (k, c) in scene.colliders.iter().enumerate() {
         // A moving collider is drawn as its triangles where it is now.
+        if let Some(tris) = scene.collider_triangles_at(k, t) {
+            tris.into_iter().for_each(|tri| list.flat(tri, TABLE));
+            continue;
+        }
         if let Some(pose) = scene.collider_pose(k, t) {
             let half = (Vec3::zeros(), Vec3::zeros());
             for tri in c.triangles(Vec3::zeros(), 0.0, half) {

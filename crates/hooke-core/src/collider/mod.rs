@@ -151,9 +151,12 @@ pub trait Collider: Debug + Send + Sync {
         false
     }
 
-    /// The keys a moving collider follows (`None` for a still one).
-    fn motion(&self) -> Option<&crate::keyframes::Keyframes> {
-        None
+    /// The spans of time `(t0, t1)` over which the collider moves, each short enough for
+    /// [`Collider::sweep`] to bound it (a keyed turn cut into parts of at most 30°); none
+    /// for a still collider. The energy watch sums its allowance for the collider's work
+    /// over them.
+    fn motion_spans(&self) -> Vec<(f64, f64)> {
+        Vec::new()
     }
 
     /// How far at most a material point of the collider moves from time `t0` to `t1`, of

@@ -9,6 +9,10 @@ use crate::keyframes::Keyframes;
 use crate::particles::Vec3;
 use nalgebra::Rotation3;
 
+/// Parts at least each pair of keys is cut into for [`Collider::motion_spans`], so that
+/// the sweep of each is near the motion's length along a curved path.
+const SPANS_PER_KEY: usize = 32;
+
 /// A rigid pose: `x ↦ pivot + translate + rotation (x - pivot)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Pose {
@@ -182,8 +186,21 @@ impl Collider for Moving {
         true
     }
 
-    fn motion(&self) -> Option<&Keyframes> {
-        Some(&self.keys)
+    fn motion_spans(&self) -> Vec<(f64, f64)> {
+        let mut spans = Vec::new();
+        for pair in self.keys.keys().windows(2) {
+            let (ta, tb) = (pair[0].t, pair[1].t);
+            // A sweep has no bound for a turn of 60° or more: a spinning collider's span is
+            // cut until each part turns at most 30° about every axis.
+            let turn = (pair[1].rotate - pair[0].rotate).abs().max();
+            let parts = SPANS_PER_KEY.max((turn / 30.0).ceil().min(1e6) as usize);
+            let step = (tb - ta) / parts as f64;
+            spans.extend((0..parts).map(|k| {
+                let t = ta + step * k as f64;
+                (t, t + step)
+            }));
+        }
+        spans
     }
 
     fn sweep(&self, (t0, t1): (f64, f64), lo: &Vec3, hi: &Vec3) -> f64 {

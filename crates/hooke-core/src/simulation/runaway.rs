@@ -30,6 +30,7 @@
 use crate::forces::air::AirForces;
 use crate::integrator::Integrator;
 use crate::model::Model;
+use crate::model::motion::PinMotion;
 use crate::particles::{Particles, Vec3};
 use crate::simulation::divergence::Divergence;
 use crate::simulation::stability::StabilityEstimate;
@@ -153,7 +154,7 @@ impl EnergyWatch {
             particle,
             what: format!(
                 "moves at {:.3e} m/s: the energy grew from {:.4e} J to {:.4e} J, far beyond \
-                 the {:.3e} J that the field, the air, the attachments, the keyed pins and the \
+                 the {:.3e} J that the field, the air, the attachments, the moving pins and the \
                  moving colliders supplied{cause}",
                 p.v[particle].norm(),
                 self.start,
@@ -246,14 +247,11 @@ impl Sources {
             (self.field, "the force field".to_string()),
             (self.air, "the air".to_string()),
             (self.attachments, "the attachments".to_string()),
-            (self.pins, "the keyed pins ([body.pin_motion])".to_string()),
+            (self.pins, "the moving pins ([body.pin_motion])".to_string()),
         ];
         for (k, &w) in self.colliders.iter().enumerate() {
             if let Some(slot) = model.colliders.get(k) {
-                named.push((
-                    w,
-                    format!("collider[{k}] ({}), moving by its keys", slot.shape.name()),
-                ));
+                named.push((w, format!("collider[{k}] ({}), moving", slot.shape.name())));
             }
         }
         named
@@ -269,38 +267,23 @@ impl Sources {
 /// The most the moving colliders can give the bodies (their work is not summed as the
 /// pins' is): for each, every free particle thrown at twice the collider's largest speed
 /// (a bounce off it) and lifted by the length of its path, both measured with
-/// [`crate::Collider::sweep`] over the bodies' box at the start, on spans between keys cut
-/// into [`SPANS_PER_KEY`] so that each turns little.
+/// [`crate::Collider::sweep`] over the bodies' box at the start, on the collider's
+/// [`crate::Collider::motion_spans`].
 fn collider_allowance(model: &Model, (lo, hi): (&Vec3, &Vec3), free_mass: f64) -> f64 {
     let mut total = 0.0;
     for slot in &model.colliders {
-        let Some(keys) = slot.shape.motion() else {
-            continue;
-        };
         let (mut speed, mut path) = (0.0_f64, 0.0_f64);
-        for pair in keys.keys().windows(2) {
-            let (ta, tb) = (pair[0].t, pair[1].t);
-            // A sweep has no bound for a turn of 60° or more: a spinning collider's span is
-            // cut until each part turns at most 30° about every axis.
-            let turn = (pair[1].rotate - pair[0].rotate).abs().max();
-            let spans = SPANS_PER_KEY.max((turn / 30.0).ceil().min(1e6) as usize);
-            let step = (tb - ta) / spans as f64;
-            for k in 0..spans {
-                let t = ta + step * k as f64;
-                let s = slot.shape.sweep((t, t + step), lo, hi);
-                path += s;
-                if step > 0.0 {
-                    speed = speed.max(s / step);
-                }
+        for (t0, t1) in slot.shape.motion_spans() {
+            let s = slot.shape.sweep((t0, t1), lo, hi);
+            path += s;
+            if t1 > t0 {
+                speed = speed.max(s / (t1 - t0));
             }
         }
         total += free_mass * (2.0 * speed * speed + model.gravity.norm() * path);
     }
     total
 }
-
-/// Spans each interval between two keys is cut into when bounding a collider's speed.
-const SPANS_PER_KEY: usize = 32;
 
 /// The power keyframed pins put in now: each moving pinned particle is held against its
 /// springs and its weight, so the holder's force is minus their sum, counted where it
@@ -387,9 +370,9 @@ fn likely_cause(model: &Model, p: &Particles) -> String {
     let pins = pin_speed(model);
     let keyed = if pins > 0.0 {
         format!(
-            "; the keyed pins ([body.pin_motion]) move at up to {} m/s, and pins keyed faster \
-             than their springs can follow, or whose first key is not where they start, pull \
-             their body apart",
+            "; the moving pins ([body.pin_motion]) move at up to {} m/s, and pins moved faster \
+             than their springs can follow, or whose first key or sample is not where they \
+             start, pull their body apart",
             crate::Approx(pins)
         )
     } else {
@@ -398,24 +381,12 @@ fn likely_cause(model: &Model, p: &Particles) -> String {
     format!("{}{keyed}", collider_or_step_cause(model, p))
 }
 
-/// The fastest any keyed pin moves between two keys, m/s: the translation's speed plus the
-/// turn's rate (radians, summed over the axes as a bound) times the pin's distance from the
-/// pins' centre.
+/// The fastest any moving pin moves, m/s ([`PinMotion::speed`]).
 fn pin_speed(model: &Model) -> f64 {
     model
         .pin_motions
         .iter()
-        .map(|m| {
-            let reach = m.offsets.iter().map(|o| o.norm()).fold(0.0, f64::max);
-            m.keys
-                .keys()
-                .windows(2)
-                .map(|w| {
-                    let turn = (w[1].rotate - w[0].rotate).map(f64::to_radians).abs().sum();
-                    ((w[1].translate - w[0].translate).norm() + turn * reach) / (w[1].t - w[0].t)
-                })
-                .fold(0.0, f64::max)
-        })
+        .map(PinMotion::speed)
         .fold(0.0, f64::max)
 }
 

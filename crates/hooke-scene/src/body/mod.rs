@@ -71,26 +71,79 @@ pub(crate) fn build_body(
     Ok(built)
 }
 
-/// A body's keyframed pins (docs/physics.md §1.2): its pinned particles `pins` (within
-/// the body), moved by `motion`.
+/// A body's moving pins (docs/physics.md §1.2): its pinned particles (`built.pins`, within
+/// the body, whose first particle is `start`), moved rigidly by `motion`'s keys, or each to
+/// its own vertex's point in `motion`'s cache (one point per vertex of the body: a mesh
+/// body's file vertices in order, a generated body's particles), placed as the body is.
 pub(crate) fn pin_motion(
-    pins: &[usize],
-    motion: &crate::spec::MotionSpec,
+    built: &BuiltBody,
+    body: &BodySpec,
     key: &str,
     start: usize,
     particles: &Particles,
+    base: &std::path::Path,
 ) -> Result<PinMotion, BuildError> {
-    if pins.is_empty() {
+    let motion = body
+        .pin_motion
+        .as_ref()
+        .expect("called for a body with a pin_motion");
+    let at = format!("{key}.pin_motion");
+    if built.pins.is_empty() {
         return Err(invalid(
-            format!("{key}.pin_motion"),
+            at,
             "it moves the body's pinned particles, and the body has none: give `pins`",
         ));
     }
-    let keys = crate::colliders::keyframes(motion, &format!("{key}.pin_motion"))?;
-    let mut ids: Vec<u32> = pins.iter().map(|&p| (start + p) as u32).collect();
-    ids.sort_unstable();
-    ids.dedup();
-    Ok(PinMotion::new(ids, &particles.x, keys))
+    let mut pins = built.pins.clone();
+    pins.sort_unstable();
+    pins.dedup();
+    let ids: Vec<u32> = pins.iter().map(|&p| (start + p) as u32).collect();
+    let Some((cache, fps)) = crate::colliders::cache_of(motion, &at)? else {
+        let keys = crate::colliders::keyframes(motion, &at)?;
+        return Ok(PinMotion::new(ids, &particles.x, keys));
+    };
+    let scale = match &body.shape {
+        ShapeSpec::Mesh { scale, .. } => Vec3::new(scale[0].get(), scale[1].get(), scale[2].get()),
+        ShapeSpec::Solid { .. } => {
+            return Err(invalid(
+                format!("{at}.cache"),
+                "a jelly's pinned particles are its lattice's, which no mesh vertex is: move \
+                 them with `keys`",
+            ));
+        }
+        _ => Vec3::repeat(1.0),
+    };
+    // Each pinned particle follows the first of the vertices that are it (welded ones
+    // share a particle).
+    let (count, vertex): (usize, Vec<usize>) = match &built.skin {
+        Some(skin) => {
+            let mut first = vec![usize::MAX; built.local.len()];
+            for (v, s) in skin.vertices.iter().enumerate().rev() {
+                if let crate::skin::SkinVertex::Particle(p) = s {
+                    first[*p as usize] = v;
+                }
+            }
+            (
+                skin.vertices.len(),
+                pins.iter().map(|&p| first[p]).collect(),
+            )
+        }
+        None => (built.local.len(), pins.clone()),
+    };
+    let placement = hooke_collide::Placement {
+        translate: vec3(&body.origin),
+        rotate: vec3(&body.rotate),
+        scale,
+    };
+    let frames = hooke_collide::VertexCache::read(&base.join(cache), count, fps, &placement)
+        .map_err(|source| BuildError::Mesh {
+            key: format!("{at}.cache"),
+            source,
+        })?;
+    let samples = (0..frames.len())
+        .map(|k| vertex.iter().map(|&v| frames.sample(k)[v]).collect())
+        .collect();
+    Ok(PinMotion::track(ids, samples, frames.interval()))
 }
 
 /// A body's `mass` per particle, which a body without a material must give.

@@ -77,9 +77,9 @@ impl SceneSpec {
             }
             particles.pin(start + pin);
         }
-        if let Some(motion) = &body.pin_motion {
+        if body.pin_motion.is_some() {
             out.pin_motions
-                .push(pin_motion(&built.pins, motion, key, start, particles)?);
+                .push(pin_motion(&built, body, key, start, particles, base)?);
         }
         out.springs.extend(built.springs);
         let triangles = match built.triangles {

@@ -70,7 +70,7 @@ impl SceneSpec {
         } else {
             built.particles.centroid()
         };
-        let (colliders, geometry) = self.build_colliders(base, &centroid)?;
+        let (colliders, geometry, animations) = self.build_colliders(base, &centroid)?;
         let model = Model {
             springs: built.springs,
             gravity: vec3(&self.simulation.gravity),
@@ -128,6 +128,7 @@ impl SceneSpec {
             every,
             bodies: built.bodies,
             colliders: geometry,
+            animations,
             pushed_out,
             build_warnings: built.warnings,
         })

@@ -1,6 +1,6 @@
 //! A scene's colliders (with their drawing geometry) and its force field.
 
-use crate::colliders::{build_collider, response};
+use crate::colliders::{build_collider, cache_of, deforming, response};
 use crate::error::{BuildError, invalid};
 use crate::limits::MAX_PENALTY;
 use crate::scene::ColliderGeometry;
@@ -8,17 +8,28 @@ use crate::spec::*;
 use hooke_core::Num;
 use hooke_core::{ColliderSlot, ForceField, Vec3};
 use std::path::Path;
+use std::sync::Arc;
+
+/// The built colliders, their drawing geometry and the deforming meshes' animations, each
+/// in file order.
+pub(super) type Colliders = (
+    Vec<ColliderSlot>,
+    Vec<ColliderGeometry>,
+    Vec<Option<Arc<hooke_collide::DeformingMesh>>>,
+);
 
 impl SceneSpec {
-    /// The colliders in file order, with their geometry for drawing; an inclined plane is
-    /// placed relative to the bodies' `centroid`.
+    /// The colliders in file order, with their geometry for drawing (and, for a mesh its
+    /// cache deforms, the animation); an inclined plane is placed relative to the bodies'
+    /// `centroid`.
     pub(super) fn build_colliders(
         &self,
         base: &Path,
         centroid: &Vec3,
-    ) -> Result<(Vec<ColliderSlot>, Vec<ColliderGeometry>), BuildError> {
+    ) -> Result<Colliders, BuildError> {
         let mut slots = Vec::new();
         let mut geometry = Vec::new();
+        let mut animations = Vec::new();
         for (c, spec) in self.colliders.iter().enumerate() {
             let key = format!("collider[{c}]");
             // Penalty forces need an inside: a mesh under one must be a closed solid. The
@@ -38,6 +49,20 @@ impl SceneSpec {
                     }
                 }
             }
+            let cache = match &spec.motion {
+                Some(motion) => cache_of(motion, &format!("{key}.motion"))?,
+                None => None,
+            };
+            if let Some(cache) = cache {
+                let mesh = deforming(&spec.shape, cache, &key, base)?;
+                geometry.push(ColliderGeometry::Mesh(mesh.triangles_at(0.0)));
+                animations.push(Some(Arc::new(mesh.clone())));
+                slots.push(ColliderSlot {
+                    shape: Box::new(mesh),
+                    response: response(&spec.response),
+                });
+                continue;
+            }
             let (mut shape, geo) = build_collider(&spec.shape, &key, base, centroid, solid)?;
             if let Some(motion) = &spec.motion {
                 shape = crate::colliders::moving(shape, &spec.shape, motion, &key)?;
@@ -47,8 +72,9 @@ impl SceneSpec {
                 response: response(&spec.response),
             });
             geometry.push(geo);
+            animations.push(None);
         }
-        Ok((slots, geometry))
+        Ok((slots, geometry, animations))
     }
 
     /// The force field, or `None` when there is none or it is zero everywhere.

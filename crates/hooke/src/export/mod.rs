@@ -271,7 +271,7 @@ pub fn collider_triangles(scene: &Scene) -> Vec<(String, Vec<[Vec3; 3]>)> {
 }
 
 /// `colliders` (as [`collider_triangles`] gives them, in scene order) with each moving one
-/// at its pose at the scene's current time.
+/// at its pose at the scene's current time, and each deforming one as its cache has it then.
 pub fn posed(
     scene: &Scene,
     colliders: &[(String, Vec<[Vec3; 3]>)],
@@ -281,6 +281,10 @@ pub fn posed(
         .iter()
         .enumerate()
         .map(|(k, (name, tris))| match scene.collider_pose(k, t) {
+            _ if scene.animations.get(k).is_some_and(Option::is_some) => (
+                name.clone(),
+                scene.collider_triangles_at(k, t).unwrap_or_default(),
+            ),
             Some(pose) => (
                 name.clone(),
                 tris.iter().map(|tri| tri.map(|p| pose.place(&p))).collect(),

@@ -16,7 +16,8 @@
 //! vertices in their count and order, its faces as written (quads stay quads) and its
 //! texture coordinates as `primvars:st`, per face corner. The colliders are meshes under
 //! `/World/colliders` where the scene placed them (see [`super::collider_triangles`]); a
-//! moving one has a time-sampled `xformOp:transform` with its pose at each frame. Positions and velocities are
+//! moving one has a time-sampled `xformOp:transform` with its pose at each frame, a
+//! deforming one (a mesh its cache animates) time-sampled `points`. Positions and velocities are
 //! `float` as the schemas declare them, each the `f32` nearest the simulation's `f64`.
 //!
 //! A time-sampled attribute holds all its frames in one block, so the frames cannot go
@@ -97,10 +98,14 @@ pub struct UsdExport {
     path: PathBuf,
     scene: String,
     bodies: Vec<BodyStream>,
-    /// The colliders' prims, each a `{transform}` slot where a moving one's samples go.
+    /// The colliders' prims, each a `{transform}` slot where a moving or deforming one's
+    /// samples go.
     colliders: Vec<String>,
-    /// Per collider: its `xformOp:transform` samples so far (empty for a still one).
+    /// Per collider: its `xformOp:transform` samples so far, or a deforming one's `points`
+    /// samples (empty for a still one).
     transforms: Vec<String>,
+    /// Per collider, whether a cache deforms it (its samples are points, not transforms).
+    deforming: Vec<bool>,
     frames: u64,
     /// Seconds between frames.
     frame_time: f64,
@@ -136,6 +141,9 @@ impl UsdExport {
             bodies,
             colliders: colliders(scene)?,
             transforms: vec![String::new(); scene.colliders.len()],
+            deforming: (0..scene.colliders.len())
+                .map(|k| scene.animations.get(k).is_some_and(Option::is_some))
+                .collect(),
             frames: 0,
             frame_time: scene.every as f64 * scene.simulation.dt(),
             x: Vec::new(),
@@ -177,9 +185,16 @@ impl UsdExport {
             writeln!(file.writer(), "    }}")?;
         }
         writeln!(file.writer(), "    def Xform \"colliders\"\n    {{")?;
-        for (prim, samples) in self.colliders.iter().zip(&self.transforms) {
+        for ((prim, samples), deforming) in self
+            .colliders
+            .iter()
+            .zip(&self.transforms)
+            .zip(&self.deforming)
+        {
             let transform = if samples.is_empty() {
                 String::new()
+            } else if *deforming {
+                format!("            point3f[] points.timeSamples = {{\n{samples}            }}\n")
             } else {
                 format!(
                     "            matrix4d xformOp:transform.timeSamples = {{\n{samples}            }}\n\
@@ -348,7 +363,14 @@ impl crate::Sink for UsdExport {
         }
         let t = scene.simulation.time();
         for (k, samples) in self.transforms.iter_mut().enumerate() {
-            if let Some(pose) = scene.collider_pose(k, t) {
+            if let Some(triangles) = scene.collider_triangles_at(k, t) {
+                let points: Vec<String> = triangles
+                    .iter()
+                    .flatten()
+                    .map(|p| tuple(super::f32s(p)))
+                    .collect();
+                let _ = writeln!(samples, "                {frame}: [{}],", points.join(", "));
+            } else if let Some(pose) = scene.collider_pose(k, t) {
                 let _ = writeln!(samples, "                {frame}: {},", pose_matrix(&pose));
             }
         }
