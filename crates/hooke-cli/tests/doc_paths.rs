@@ -15,8 +15,9 @@ fn root() -> PathBuf {
 
 /// Where a mentioned path starts when it names something in the repository. Anything else
 /// (`out/`, `t.csv`, `mine.toml`) is an example output or the user's own file.
-const REPO_PREFIXES: [&str; 11] = [
+const REPO_PREFIXES: [&str; 12] = [
     "examples/",
+    "blender/",
     "crates/",
     "assets/",
     "tests/",

@@ -4,7 +4,8 @@
 //! virtual environment, `target/python` — builds and installs the `hooke` Python package
 //! there, runs `cargo test --workspace` with any further arguments passed through and
 //! `HOOKE_PYTHON` naming that environment's Python, then the Python package's tests with
-//! pytest.
+//! pytest; and the Blender extension's tests in `target/blender` with bpy from pip
+//! (`blender/requirements-test.txt`).
 //!
 //! Plain `std`, no dependencies: it builds in a second, before anything else.
 
@@ -49,6 +50,9 @@ const USAGE: &str = "usage: cargo xtask test [ARGS…]   set up what the tests n
 
 /// The Python packages the tests need, pinned.
 const REQUIREMENTS_TXT: &str = "python/requirements-test.txt";
+/// What the Blender extension's tests need (bpy, which pins numpy below 2: an environment
+/// of its own).
+const BLENDER_REQUIREMENTS_TXT: &str = "blender/requirements-test.txt";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -165,15 +169,21 @@ fn run(program: &Path, args: &[&str], what: &str) -> Result<(), String> {
 /// The Python of the virtual environment `target/python`, created and given the pinned
 /// packages of [`REQUIREMENTS_TXT`] unless it already has them.
 fn python() -> Result<PathBuf, String> {
+    environment("python", REQUIREMENTS_TXT)
+}
+
+/// The Python of the virtual environment `target/NAME`, created and given the pinned
+/// packages of `requirements` (relative to the root) unless it already has them.
+fn environment(name: &str, requirements: &str) -> Result<PathBuf, String> {
     let target =
         std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root().join("target"), PathBuf::from);
-    let env = target.join("python");
+    let env = target.join(name);
     let python = env.join("bin/python");
-    let requirements = root().join(REQUIREMENTS_TXT);
+    let requirements_path = root().join(requirements);
     // A stamp of the requirements installed: pip is asked again only when they change.
     let stamp = env.join("hooke-requirements.txt");
-    let wanted = std::fs::read_to_string(&requirements)
-        .map_err(|e| format!("cannot read {}: {e}", requirements.display()))?;
+    let wanted = std::fs::read_to_string(&requirements_path)
+        .map_err(|e| format!("cannot read {}: {e}", requirements_path.display()))?;
     if python.exists() && std::fs::read_to_string(&stamp).is_ok_and(|s| s == wanted) {
         return Ok(python);
     }
@@ -209,8 +219,8 @@ fn python() -> Result<PathBuf, String> {
             )?;
         }
     }
-    eprintln!("xtask: installing the tests' Python packages ({REQUIREMENTS_TXT})");
-    let requirements_text = requirements.to_string_lossy().into_owned();
+    eprintln!("xtask: installing the tests' Python packages ({requirements})");
+    let requirements_text = requirements_path.to_string_lossy().into_owned();
     run(
         &python,
         &[
@@ -302,6 +312,11 @@ fn test(args: &[String], python: &Path) -> Result<ExitCode, String> {
             ));
         }
     }
+    if args.is_empty()
+        && let Err(e) = blender()
+    {
+        failed.push(e);
+    }
     if failed.is_empty() {
         eprintln!("xtask: every test suite passed");
         return Ok(ExitCode::SUCCESS);
@@ -311,4 +326,41 @@ fn test(args: &[String], python: &Path) -> Result<ExitCode, String> {
         eprintln!("  - {f}");
     }
     Ok(ExitCode::FAILURE)
+}
+
+/// The Blender extension's tests (`blender/tests`, pytest with bpy from pip, in the
+/// environment `target/blender`), driving a release build of hooke: a bake runs it twice
+/// per scene, which a debug build takes minutes for. `HOOKE_SKIP_BLENDER=1` skips them.
+fn blender() -> Result<(), String> {
+    if std::env::var_os("HOOKE_SKIP_BLENDER").is_some() {
+        eprintln!("xtask: HOOKE_SKIP_BLENDER is set, so blender/tests did not run");
+        return Ok(());
+    }
+    let python = environment("blender", BLENDER_REQUIREMENTS_TXT)
+        .map_err(|e| format!("setting up the Blender tests: {e}; or set HOOKE_SKIP_BLENDER=1"))?;
+    eprintln!("xtask: building hooke (release) for the Blender tests");
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let status = Command::new(cargo)
+        .args(["build", "--release", "-p", "hooke-cli"])
+        .status()
+        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    if !status.success() {
+        return Err(format!("cargo build --release -p hooke-cli ({status})"));
+    }
+    let target =
+        std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root().join("target"), PathBuf::from);
+    let status = Command::new(&python)
+        .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
+        .arg(root().join("blender/tests"))
+        .env("HOOKE_BIN", target.join("release/hooke"))
+        .current_dir(root())
+        .status()
+        .map_err(|e| format!("cannot run pytest: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!(
+            "pytest blender/tests ({status}): the failing tests are listed above"
+        ))
+    }
 }

@@ -1,0 +1,299 @@
+"""A Blender scene as Hooke's: the baked object as a body, the colliders, the frame range.
+
+Hooke is +Y up in metres; Blender is +Z up in its scene units. A Blender point
+``(x, y, z)`` (in units of ``scale_length`` metres) is Hooke's ``(x, z, -y)`` times
+``scale_length``. Every position written goes through :func:`to_hooke`, every position read
+back through :func:`from_hooke`.
+"""
+
+import math
+import os
+
+from mathutils import Matrix, Vector
+
+from . import pc2
+
+#: Blender's frame (+Z up) to Hooke's (+Y up): Hooke = AXES @ Blender.
+AXES = Matrix(((1.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, -1.0, 0.0)))
+
+PRESETS = ("cotton", "silk", "wool", "denim")
+
+
+class BakeError(Exception):
+    """What stops a bake, said as Blender says errors: naming the object and the setting."""
+
+
+def to_hooke(p, scale):
+    """A Blender world point as Hooke's, metres."""
+    return (p[0] * scale, p[2] * scale, -p[1] * scale)
+
+
+def from_hooke(p, scale):
+    """A Hooke point (metres) as Blender's world point."""
+    return Vector((p[0] / scale, -p[2] / scale, p[1] / scale))
+
+
+def evaluated_positions(obj, depsgraph, skip=None):
+    """``obj``'s evaluated mesh now: its vertices in world coordinates (Blender's), in the
+    mesh's order, and its faces. ``skip`` names a modifier left out (an earlier bake's)."""
+    mod = obj.modifiers.get(skip) if skip else None
+    shown = None
+    if mod is not None:
+        shown = mod.show_viewport
+        mod.show_viewport = False
+        depsgraph.update()
+    try:
+        ev = obj.evaluated_get(depsgraph)
+        mesh = ev.to_mesh()
+        try:
+            world = ev.matrix_world.copy()
+            points = [world @ v.co for v in mesh.vertices]
+            faces = [tuple(p.vertices) for p in mesh.polygons]
+        finally:
+            ev.to_mesh_clear()
+    finally:
+        if mod is not None:
+            mod.show_viewport = shown
+            depsgraph.update()
+    return points, faces
+
+
+def write_obj(path, points, faces):
+    """An OBJ of ``points`` (Hooke's, metres) and ``faces`` (0-based corners)."""
+    with open(path, "w", encoding="utf-8") as f:
+        f.write("# written by Hooke's Blender extension\n")
+        for p in points:
+            f.write(f"v {p[0]!r} {p[1]!r} {p[2]!r}\n")
+        for face in faces:
+            f.write("f " + " ".join(str(i + 1) for i in face) + "\n")
+
+
+def frames(scene):
+    """The frames a bake covers, and the frame rate."""
+    fps = scene.render.fps / scene.render.fps_base
+    return range(scene.frame_start, scene.frame_end + 1), fps
+
+
+def setting(x):
+    """A number the user set (stored as 32-bit) as they typed it: 0.005, not 0.004999999888."""
+    return float(f"{x:.7g}")
+
+
+def toml_value(v):
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
+    if isinstance(v, float):
+        return repr(v)
+    return str(v)
+
+
+def relative_keys(track):
+    """Hooke keys ``translate``/``rotate`` for rigid poses ``track`` (``(t, location,
+    rotation)`` in Hooke's frame, rotation a 3×3 Matrix), relative to the first, with the
+    Euler angles kept continuous from key to key."""
+    t0, o0, r0 = track[0]
+    inverse = r0.transposed()
+    keys, previous = [], None
+    for t, o, r in track:
+        rel = (r @ inverse).to_euler("XYZ", previous) if previous else (r @ inverse).to_euler("XYZ")
+        previous = rel
+        keys.append(
+            "{ t = %r, translate = %s, rotate = %s }"
+            % (
+                t - t0,
+                toml_value([o[0] - o0[0], o[1] - o0[1], o[2] - o0[2]]),
+                toml_value([math.degrees(a) for a in rel]),
+            )
+        )
+    return keys
+
+
+def check_mesh(obj, what):
+    if obj.type != "MESH":
+        raise BakeError(f"Object '{obj.name}': Hooke {what} must be a mesh, not {obj.type.lower()}")
+    if len(obj.data.polygons) == 0:
+        raise BakeError(f"Object '{obj.name}': it has no faces; Hooke {what} needs a surface")
+
+
+class ColliderTrack:
+    """A collider's mesh as the bake reads it: its faces and its points at the first frame,
+    and per frame its points (deforming) or its pose (rigid)."""
+
+    def __init__(self, obj):
+        self.obj = obj
+        self.motion = obj.hooke.motion
+        self.faces = None
+        self.start = None
+        self.samples = []
+        self.poses = []
+
+    def read(self, depsgraph, frame, scale):
+        """Reads the collider at ``frame`` (its index in the bake, number and time)."""
+        k, number, t = frame
+        if k > 0 and self.motion == "STATIC":
+            return
+        if k == 0 or self.motion == "DEFORMING":
+            points, faces = evaluated_positions(self.obj, depsgraph)
+            points = [to_hooke(p, scale) for p in points]
+            if k == 0:
+                self.faces, self.start, self.first = faces, points, number
+            elif len(faces) != len(self.faces) or len(points) != len(self.start):
+                raise BakeError(
+                    f"Object '{self.obj.name}': its mesh changes topology at frame {number} "
+                    f"({len(points)} vertices and {len(faces)} faces, against "
+                    f"{len(self.start)} and {len(self.faces)} at frame {self.first}); a "
+                    "deforming collider keeps its vertices and faces (Physics > Hooke > "
+                    "Motion: Rigid, or apply the modifier that changes them)"
+                )
+            if self.motion == "DEFORMING":
+                self.samples.append(points)
+        if self.motion == "RIGID":
+            m = self.obj.evaluated_get(depsgraph).matrix_world
+            rotation = AXES @ m.to_3x3().normalized() @ AXES.transposed()
+            self.poses.append((t, to_hooke(m.translation, scale), rotation))
+
+    def write(self, folder, n, fps):
+        """Writes its files into ``folder`` as collider ``n``; returns its scene lines."""
+        name = f"collider-{n}.obj"
+        response = (
+            'response = { kind = "restitution", cr = 0.0, '
+            f"friction = {setting(self.obj.hooke.friction)!r} }}"
+        )
+        lines = [f"# {self.obj.name} ({self.motion.lower()})", "[[collider]]"]
+        if self.motion == "RIGID":
+            pivot = self.poses[0][1]
+            write_obj(
+                os.path.join(folder, name),
+                [tuple(a - b for a, b in zip(p, pivot)) for p in self.start],
+                self.faces,
+            )
+            lines.append(
+                f'shape = {{ kind = "mesh", path = "{name}", '
+                f"translate = {toml_value(list(pivot))} }}"
+            )
+            lines.append(response)
+            lines.append("motion = { keys = [" + ", ".join(relative_keys(self.poses)) + "] }")
+            return lines
+        write_obj(os.path.join(folder, name), self.start, self.faces)
+        lines += [f'shape = {{ kind = "mesh", path = "{name}" }}', response]
+        if self.motion == "DEFORMING":
+            cache = f"collider-{n}.pc2"
+            pc2.write(os.path.join(folder, cache), self.samples)
+            lines.append(f'motion = {{ cache = "{cache}", fps = {fps!r} }}')
+        return lines
+
+
+def write_scene(context, obj, folder, modifier):
+    """Writes the scene of baking ``obj`` into ``folder``: its body, every collider of the
+    scene, and ``scene.toml``; returns the scene file's path, the number of frames and the
+    object's world matrix at each (what its own coordinates are relative to).
+    ``modifier`` is the name of an earlier bake's modifier, left out of what is read."""
+    scene = context.scene
+    settings = obj.hooke
+    scale = scene.unit_settings.scale_length or 1.0
+    span, fps = frames(scene)
+    if len(span) < 2:
+        raise BakeError(
+            f"Scene '{scene.name}': its frame range {scene.frame_start}–{scene.frame_end} "
+            "has no frame to bake after the first (Output Properties > Frame Range)"
+        )
+    if settings.kind not in ("CLOTH", "JELLY"):
+        raise BakeError(
+            f"Object '{obj.name}': Hooke bakes a cloth or a jelly; set Physics > Hooke > Kind"
+        )
+    what = "cloth" if settings.kind == "CLOTH" else "jelly"
+    check_mesh(obj, f"a {what}")
+    substeps = max(1, settings.substeps)
+
+    colliders = [o for o in scene.objects if o.hooke.kind == "COLLIDER" and o is not obj]
+    for c in colliders:
+        check_mesh(c, "a collider")
+    pins = []
+    if settings.kind == "CLOTH" and settings.pin_group:
+        group = obj.vertex_groups.get(settings.pin_group)
+        if group is None:
+            raise BakeError(
+                f"Object '{obj.name}': vertex group '{settings.pin_group}' does not exist "
+                "(Physics > Hooke > Pin Group names one of the object's vertex groups)"
+            )
+        pins = [
+            v.index
+            for v in obj.data.vertices
+            if any(g.group == group.index and g.weight > 0.0 for g in v.groups)
+        ]
+        if not pins:
+            raise BakeError(
+                f"Object '{obj.name}': vertex group '{settings.pin_group}' holds no vertex "
+                "(Physics > Hooke > Pin Group)"
+            )
+
+    # Every object's evaluated mesh at every frame the bake needs, read once per frame.
+    start = scene.frame_current
+    tracks = [ColliderTrack(c) for c in colliders]
+    body_track, matrices = [], []
+    try:
+        for k, f in enumerate(span):
+            scene.frame_set(f)
+            depsgraph = context.evaluated_depsgraph_get()
+            points, faces = evaluated_positions(obj, depsgraph, modifier)
+            if k == 0:
+                body_faces = faces
+            body_track.append([to_hooke(p, scale) for p in points])
+            matrices.append(obj.evaluated_get(depsgraph).matrix_world.copy())
+            for track in tracks:
+                track.read(depsgraph, (k, f, k / fps), scale)
+    finally:
+        scene.frame_set(start)
+
+    lines = [
+        f"# Hooke scene of the Blender object '{obj.name}', written by the Hooke extension",
+        f"name = {toml_value('blender-' + obj.name)}",
+        "",
+        "[simulation]",
+        f"integrator = {toml_value(settings.integrator.lower())}",
+        f"dt = {1.0 / (fps * substeps)!r}",
+        f"steps = {(len(span) - 1) * substeps}",
+        f"every = {substeps}",
+    ]
+    gravity = scene.gravity if scene.use_gravity else Vector((0.0, 0.0, 0.0))
+    lines.append(f"gravity = {toml_value([setting(g) + 0.0 for g in to_hooke(gravity, 1.0)])}")
+    if settings.kind == "CLOTH":
+        lines.append("mass_drag = 0.1")
+    lines += ["", "[[body]]", f"name = {toml_value(obj.name)}"]
+    write_obj(os.path.join(folder, "body.obj"), body_track[0], body_faces)
+    if settings.kind == "CLOTH":
+        lines.append(f"thickness = {setting(settings.thickness) * scale!r}")
+        lines.append(f"friction = {setting(settings.friction)!r}")
+        if pins:
+            lines.append(f"pins = {toml_value(pins)}")
+            first = body_track[0]
+            if any(
+                max(abs(a - b) for a, b in zip(sample[i], first[i])) > 0.0
+                for sample in body_track[1:]
+                for i in pins
+            ):
+                pc2.write(os.path.join(folder, "pins.pc2"), body_track)
+                lines.append(f"pin_motion = {{ cache = \"pins.pc2\", fps = {fps!r} }}")
+        lines += ["", "[body.shape]", 'kind = "mesh"', 'path = "body.obj"', ""]
+        lines += ["[body.material]", f"preset = {toml_value(settings.preset)}"]
+    else:
+        lines.append(f"mass = {setting(settings.mass)!r}")
+        lines += ["", "[body.shape]", 'kind = "solid"', 'path = "body.obj"']
+        lines.append(f"spacing = {setting(settings.spacing) * scale!r}")
+        for kind, ks in (("structural", 1.0), ("shear", 1.0), ("bend", 0.5)):
+            lines += [
+                "",
+                f"[body.springs.{kind}]",
+                f"ks = {setting(settings.stiffness) * ks!r}",
+                f"kd = {setting(settings.damping)!r}",
+            ]
+    for n, track in enumerate(tracks):
+        lines += [""] + track.write(folder, n, fps)
+    path = os.path.join(folder, "scene.toml")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write("\n".join(lines) + "\n")
+    return path, len(span), matrices

@@ -1,0 +1,382 @@
+"""The Blender extension, headless: scenes built with bpy (5.0.1 from pip) and baked through
+the operator a user clicks, `bpy.ops.hooke.bake()`.
+
+Each bake is checked against `hooke run` of the scene it wrote (the Mesh Cache must play
+Hooke's trajectory, vertices in the object's order, within 1e-6 m) and for crossings with
+Blender's own BVH of the colliders' evaluated meshes, not Hooke's detection.
+`cargo xtask test` runs these in `target/blender`, a Python environment of their own (bpy
+pins numpy below 2), with HOOKE_BIN naming the hooke it built.
+"""
+
+import csv
+import math
+import os
+import signal
+import subprocess
+import sys
+import threading
+
+import pytest
+
+bpy = pytest.importorskip("bpy")
+from mathutils import Vector  # noqa: E402
+from mathutils.bvhtree import BVHTree  # noqa: E402
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
+import hooke_blender  # noqa: E402
+from hooke_blender.scene import to_hooke  # noqa: E402
+
+HOOKE = os.environ.get("HOOKE_BIN")
+
+
+@pytest.fixture(autouse=True)
+def fresh(tmp_path):
+    """An empty scene saved in ``tmp_path`` (so that ``//hooke`` is there), the extension
+    registered."""
+    if not HOOKE or not os.path.isfile(HOOKE):
+        pytest.skip("HOOKE_BIN does not name the hooke program")
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    hooke_blender.register()
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "scene.blend"))
+    yield tmp_path
+    hooke_blender.unregister()
+
+
+def activate(obj):
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+
+
+def grid(name, size, cuts, location):
+    bpy.ops.mesh.primitive_grid_add(
+        x_subdivisions=cuts, y_subdivisions=cuts, size=size, location=location
+    )
+    obj = bpy.context.active_object
+    obj.name = name
+    return obj
+
+
+def tube(name, radius, span, rings, capped):
+    """A tube of 16 sides along x over ``span`` at height 1 m, ``rings`` rings of vertices;
+    closed by a fan at each end when ``capped``."""
+    sides = 16
+    points, faces = [], []
+    for i in range(rings):
+        x = span[0] + (span[1] - span[0]) * i / (rings - 1)
+        for j in range(sides):
+            a = 2.0 * math.pi * j / sides
+            points.append((x, radius * math.sin(a), 1.0 + radius * math.cos(a)))
+    for i in range(rings - 1):
+        for j in range(sides):
+            a, b = i * sides + j, i * sides + (j + 1) % sides
+            faces.append((a, a + sides, b + sides, b))
+    if capped:
+        points += [(span[0], 0.0, 1.0), (span[1], 0.0, 1.0)]
+        first, last = len(points) - 2, len(points) - 1
+        top = (rings - 1) * sides
+        for j in range(sides):
+            faces.append((first, j, (j + 1) % sides))
+            faces.append((last, top + (j + 1) % sides, top + j))
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(points, [], faces)
+    mesh.update()
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
+def world_mesh(obj):
+    """``obj``'s evaluated vertices (world) and faces now."""
+    dg = bpy.context.evaluated_depsgraph_get()
+    ev = obj.evaluated_get(dg)
+    mesh = ev.to_mesh()
+    points = [ev.matrix_world @ v.co for v in mesh.vertices]
+    faces = [tuple(p.vertices) for p in mesh.polygons]
+    ev.to_mesh_clear()
+    return points, faces
+
+
+def trajectory(scene_file):
+    """`hooke run` of ``scene_file``: per frame, every vertex's position."""
+    out = os.path.join(os.path.dirname(scene_file), "check.csv")
+    subprocess.run(
+        [HOOKE, "run", scene_file, "--trajectory", out],
+        check=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    frames = {}
+    with open(out) as f:
+        for row in csv.DictReader(f):
+            frames.setdefault(int(row["frame"]), []).append(
+                (float(row["x"]), float(row["y"]), float(row["z"]))
+            )
+    return frames
+
+
+def assert_plays_hooke(obj):
+    """The Mesh Cache plays `hooke run`'s trajectory of the scene the bake wrote, at every
+    frame, within 1e-6 m; returns the frames' positions (Blender's world)."""
+    scene = bpy.context.scene
+    assert obj.modifiers.get("Hooke") is not None, [m.name for m in obj.modifiers]
+    scene_file = os.path.splitext(hooke_blender.cache_of(obj))[0] + "-scene/scene.toml"
+    expected = trajectory(scene_file)
+    played = {}
+    for k, f in enumerate(range(scene.frame_start, scene.frame_end + 1)):
+        scene.frame_set(f)
+        points, _ = world_mesh(obj)
+        played[f] = points
+        want = expected[k]
+        assert len(points) == len(want)
+        worst = max(
+            max(abs(a - b) for a, b in zip(to_hooke(p, 1.0), w)) for p, w in zip(points, want)
+        )
+        assert worst < 1e-6, f"frame {f}: the cache is {worst} m from hooke run"
+    return played
+
+
+def crossings(cloth_points, cloth_faces, collider):
+    """The cloth's vertices inside ``collider`` (its evaluated mesh now, a closed solid)
+    and the cloth edges that pass through its surface, by Blender's BVH."""
+    points, faces = world_mesh(collider)
+    tree = BVHTree.FromPolygons(points, faces)
+    inside = 0
+    for p in cloth_points:
+        hit = tree.find_nearest(p)
+        if hit[0] is not None and (p - hit[0]).dot(hit[1]) < -1e-7:
+            inside += 1
+    edges = {tuple(sorted((f[i], f[(i + 1) % len(f)]))) for f in cloth_faces for i in range(len(f))}
+    through = 0
+    for a, b in edges:
+        pa, pb = cloth_points[a], cloth_points[b]
+        d = pb - pa
+        hit = tree.ray_cast(pa, d.normalized(), d.length)
+        if hit[0] is not None:
+            through += 1
+    return inside, through
+
+
+def test_a_cloth_falls_on_a_rotating_cube_and_plays_hookes_trajectory(fresh):
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 1, 36
+    scene.render.fps = 24
+    cloth = grid("Cloth", 1.2, 16, (0.0, 0.0, 0.8))
+    cloth.hooke.kind = "CLOTH"
+    cloth.hooke.substeps = 2
+    bpy.ops.mesh.primitive_cube_add(size=0.5, location=(0.0, 0.0, 0.4))
+    cube = bpy.context.active_object
+    cube.name = "Cube"
+    cube.hooke.kind = "COLLIDER"
+    cube.hooke.motion = "RIGID"
+    cube.rotation_euler = (0.0, 0.0, 0.0)
+    cube.keyframe_insert("rotation_euler", frame=1)
+    cube.rotation_euler = (0.0, 0.0, math.radians(120.0))
+    cube.keyframe_insert("rotation_euler", frame=36)
+    activate(cloth)
+    assert bpy.ops.hooke.bake() == {"FINISHED"}
+    played = assert_plays_hooke(cloth)
+    _, faces = world_mesh(cloth)
+    for f in range(scene.frame_start, scene.frame_end + 1):
+        scene.frame_set(f)
+        inside, through = crossings(played[f], faces, cube)
+        assert inside == 0 and through == 0, f"frame {f}: {inside} inside, {through} through"
+    # It fell onto the cube: the middle rests on the top, the corners hang below it.
+    top = max(p.z for p in played[scene.frame_end])
+    low = min(p.z for p in played[scene.frame_end])
+    assert 0.64 < top < 0.7 and low < 0.5, (top, low)
+
+
+def test_a_sleeve_on_an_arm_bent_by_its_armature_never_enters_it(fresh):
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 1, 30
+    scene.render.fps = 24
+    # The arm: a capped tube along x, 1 m long, skinned to two bones meeting at x = 0.
+    arm = tube("Arm", 0.08, (-0.5, 0.5), 21, capped=True)
+    bpy.ops.object.armature_add(location=(-0.5, 0.0, 1.0))
+    rig = bpy.context.active_object
+    bpy.ops.object.mode_set(mode="EDIT")
+    upper = rig.data.edit_bones[0]
+    upper.name = "upper"
+    upper.head, upper.tail = (-0.5, 0.0, 1.0), (0.0, 0.0, 1.0)
+    fore = rig.data.edit_bones.new("fore")
+    fore.head, fore.tail = (0.0, 0.0, 1.0), (0.5, 0.0, 1.0)
+    fore.parent = upper
+    bpy.ops.object.mode_set(mode="OBJECT")
+    rig.location = (0.0, 0.0, 0.0)
+    for name in ("upper", "fore"):
+        arm.vertex_groups.new(name=name)
+    for v in arm.data.vertices:
+        w = min(1.0, max(0.0, (v.co.x + 0.1) / 0.2))
+        arm.vertex_groups["upper"].add([v.index], 1.0 - w, "REPLACE")
+        arm.vertex_groups["fore"].add([v.index], w, "REPLACE")
+    mod = arm.modifiers.new("rig", "ARMATURE")
+    mod.object = rig
+    pose = rig.pose.bones["fore"]
+    pose.rotation_mode = "XYZ"
+    for frame, angle in ((1, 0.0), (15, -50.0), (30, 0.0)):
+        pose.rotation_euler = (0.0, 0.0, math.radians(angle))
+        pose.keyframe_insert("rotation_euler", frame=frame)
+    arm.hooke.kind = "COLLIDER"
+    arm.hooke.motion = "DEFORMING"
+    arm.hooke.friction = 0.5
+    # The sleeve: an open tube around the arm from the shoulder past the elbow.
+    sleeve = tube("Sleeve", 0.12, (-0.45, 0.25), 15, capped=False)
+    shoulder = sleeve.vertex_groups.new(name="shoulder")
+    shoulder.add([v.index for v in sleeve.data.vertices if v.co.x < -0.44], 1.0, "REPLACE")
+    sleeve.hooke.kind = "CLOTH"
+    sleeve.hooke.preset = "silk"
+    sleeve.hooke.pin_group = "shoulder"
+    sleeve.hooke.substeps = 2
+    activate(sleeve)
+    assert bpy.ops.hooke.bake() == {"FINISHED"}
+    played = assert_plays_hooke(sleeve)
+    _, faces = world_mesh(sleeve)
+    pinned = [v.index for v in sleeve.data.vertices if v.co.x < -0.44]
+    for f in range(scene.frame_start, scene.frame_end + 1):
+        scene.frame_set(f)
+        inside, through = crossings(played[f], faces, arm)
+        assert inside == 0 and through == 0, f"frame {f}: {inside} inside, {through} through"
+        for i in pinned:
+            assert (played[f][i] - sleeve.data.vertices[i].co).length < 1e-6
+    # The forearm bent down at frame 15 and the sleeve's far end went with it.
+    far = [p for p in played[15] if p.x > 0.1]
+    assert min(p.z for p in far) < 0.9, min(p.z for p in far)
+
+
+def test_a_jelly_from_a_closed_mesh_lands_on_a_plane(fresh):
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 1, 24
+    scene.render.fps = 24
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=2, radius=0.3, location=(0.0, 0.0, 0.6))
+    jelly = bpy.context.active_object
+    jelly.name = "Jelly"
+    jelly.hooke.kind = "JELLY"
+    jelly.hooke.spacing = 0.1
+    jelly.hooke.integrator = "NEWTON"
+    jelly.hooke.substeps = 4
+    bpy.ops.mesh.primitive_cube_add(size=3.0, location=(0.0, 0.0, -1.5))
+    floor = bpy.context.active_object
+    floor.name = "Floor"
+    floor.hooke.kind = "COLLIDER"
+    activate(jelly)
+    assert bpy.ops.hooke.bake() == {"FINISHED"}
+    played = assert_plays_hooke(jelly)
+    _, faces = world_mesh(jelly)
+    for f in range(scene.frame_start, scene.frame_end + 1):
+        scene.frame_set(f)
+        inside, _ = crossings(played[f], faces, floor)
+        assert inside == 0, f"frame {f}: {inside} of the jelly's vertices in the floor"
+    # Dropped 0.3 m from rest, it reached the floor within the second.
+    assert min(p.z for p in played[scene.frame_end]) < 0.05
+
+
+def test_bad_settings_are_refused_naming_the_object_and_the_setting(fresh):
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 1, 5
+    cloth = grid("Cloth", 1.0, 4, (0.0, 0.0, 1.0))
+    cloth.hooke.kind = "CLOTH"
+    cloth.hooke.pin_group = "hem"
+    activate(cloth)
+    with pytest.raises(RuntimeError, match=r"Object 'Cloth': vertex group 'hem' does not exist"):
+        bpy.ops.hooke.bake()
+    cloth.hooke.pin_group = ""
+    bpy.ops.mesh.primitive_circle_add(vertices=8, radius=0.3, fill_type="NOTHING")
+    ring = bpy.context.active_object
+    ring.name = "Ring"
+    ring.hooke.kind = "COLLIDER"
+    activate(cloth)
+    with pytest.raises(RuntimeError, match=r"Object 'Ring': it has no faces"):
+        bpy.ops.hooke.bake()
+    bpy.data.objects.remove(ring)
+    # A deforming collider whose modifier changes its faces from frame to frame.
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.2, location=(0.0, 0.0, 0.3))
+    ball = bpy.context.active_object
+    ball.name = "Ball"
+    ball.hooke.kind = "COLLIDER"
+    ball.hooke.motion = "DEFORMING"
+    build = ball.modifiers.new("build", "BUILD")
+    build.frame_start, build.frame_duration = 1, 4
+    activate(cloth)
+    with pytest.raises(RuntimeError, match=r"Object 'Ball': its mesh changes topology at frame 2"):
+        bpy.ops.hooke.bake()
+
+
+def test_a_cancelled_bake_keeps_the_earlier_cache_playing(fresh):
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 1, 12
+    cloth = grid("Cloth", 1.0, 10, (0.0, 0.0, 1.0))
+    cloth.hooke.kind = "CLOTH"
+    activate(cloth)
+    assert bpy.ops.hooke.bake() == {"FINISHED"}
+    cache = hooke_blender.cache_of(cloth)
+    before = open(cache, "rb").read()
+    # A long bake, interrupted as Ctrl-C interrupts `blender --background`.
+    scene.frame_end = 2000
+    cloth.hooke.substeps = 8
+    timer = threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        assert bpy.ops.hooke.bake() == {"CANCELLED"}
+    finally:
+        timer.cancel()
+    assert open(cache, "rb").read() == before
+    assert cloth.modifiers["Hooke"].filepath == cache
+    leftovers = [n for n in os.listdir(os.path.dirname(cache)) if n.startswith(".bake-")]
+    assert leftovers == []
+    scene.frame_end = 12
+    assert_plays_hooke(cloth)
+    assert bpy.ops.hooke.free_bake() == {"FINISHED"}
+    assert cloth.modifiers.get("Hooke") is None and not os.path.exists(cache)
+
+
+INSTALLED = r"""
+import os, sys, bpy
+zip_path, hooke = sys.argv[-2], sys.argv[-1]
+bpy.ops.wm.read_factory_settings(use_empty=True)
+assert bpy.ops.extensions.package_install_files(
+    filepath=zip_path, repo="user_default", enable_on_install=True
+) == {"FINISHED"}
+prefs = bpy.context.preferences.addons["bl_ext.user_default.hooke"].preferences
+prefs.program = hooke
+scene = bpy.context.scene
+scene.frame_start, scene.frame_end = 1, 6
+bpy.ops.mesh.primitive_grid_add(x_subdivisions=6, y_subdivisions=6, size=1.0, location=(0, 0, 1))
+cloth = bpy.context.active_object
+cloth.hooke.kind = "CLOTH"
+assert bpy.ops.hooke.bake() == {"FINISHED"}
+assert cloth.modifiers["Hooke"].type == "MESH_CACHE"
+scene.frame_set(6)
+dg = bpy.context.evaluated_depsgraph_get()
+low = min((cloth.matrix_world @ v.co).z for v in cloth.evaluated_get(dg).to_mesh().vertices)
+print("LOWEST", low)
+"""
+
+
+def test_the_zip_installs_as_an_extension_and_bakes(tmp_path):
+    """The zip `blender/build.py` makes, installed through Blender's own Install from Disk
+    (in a fresh user folder, in a Blender of its own), registers the panel's settings and
+    the operator, finds hooke through its preference, and bakes a falling cloth."""
+    build = os.path.join(os.path.dirname(__file__), "..", "build.py")
+    out = subprocess.run(
+        [sys.executable, build, "--out", str(tmp_path)], check=True, capture_output=True, text=True
+    )
+    zip_path = out.stdout.strip()
+    script = tmp_path / "installed.py"
+    script.write_text(INSTALLED)
+    home = tmp_path / "home"
+    home.mkdir()
+    env = dict(os.environ, HOME=str(home), BLENDER_USER_RESOURCES=str(home / "blender"))
+    env.pop("HOOKE_BIN", None)
+    done = subprocess.run(
+        [sys.executable, str(script), zip_path, HOOKE],
+        env=env,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    lowest = float(done.stdout.split("LOWEST")[1].split()[0])
+    # Five implicit Euler steps of 1/24 s from rest fall g dt² (1 + … + 5) = 25.5 cm (the
+    # continuous ½ g t² is 21.3 cm); the cloth's air drag takes a little off.
+    assert 0.74 < lowest < 0.76, lowest
