@@ -2,7 +2,7 @@
 //! "Caches"): each pin at its own target at every step, and every misfit refused naming the
 //! key, the file and what was expected.
 
-use crate::deforming::{build, folder, moving_plane, write_pc2};
+use crate::deforming::{SPRINGS, build, folder, moving_plane, write_pc2};
 use hooke_core::Vec3;
 use std::f64::consts::PI;
 
@@ -58,15 +58,7 @@ pin_motion = {{ cache = "edge.pc2", fps = 30.0 }}
 kind = "grid"
 size = [{n}, {n}]
 spacing = {spacing}
-[body.springs.structural]
-ks = 300.0
-kd = 0.02
-[body.springs.shear]
-ks = 150.0
-kd = 0.02
-[body.springs.bend]
-ks = 15.0
-kd = 0.005
+{SPRINGS}
 "#,
             origin.x,
             origin.y,

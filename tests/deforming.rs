@@ -13,6 +13,17 @@ use std::path::{Path, PathBuf};
 
 const G: f64 = 9.81;
 
+/// The springs of the built-in cloths (cloth-table's), for the scenes here.
+pub(crate) const SPRINGS: &str = "[body.springs.structural]
+ks = 300.0
+kd = 0.02
+[body.springs.shear]
+ks = 150.0
+kd = 0.02
+[body.springs.bend]
+ks = 15.0
+kd = 0.005";
+
 /// A fresh folder for one test's files.
 pub(crate) fn folder(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("hooke-deforming-{}-{name}", std::process::id()));
@@ -232,15 +243,7 @@ friction = 0.3
 kind = "grid"
 size = [{n}, {n}]
 spacing = {spacing}
-[body.springs.structural]
-ks = 300.0
-kd = 0.02
-[body.springs.shear]
-ks = 150.0
-kd = 0.02
-[body.springs.bend]
-ks = 15.0
-kd = 0.005
+{SPRINGS}
 [[collider]]
 shape = {{ kind = "ground", height = 0.0 }}
 response = {{ kind = "restitution", cr = 0.2, friction = 0.5 }}
@@ -401,15 +404,7 @@ friction = 0.5
 kind = "grid"
 size = [20, 6]
 spacing = 0.05
-[body.springs.structural]
-ks = 300.0
-kd = 0.02
-[body.springs.shear]
-ks = 150.0
-kd = 0.02
-[body.springs.bend]
-ks = 15.0
-kd = 0.005
+{SPRINGS}
 [[collider]]
 shape = {{ kind = "ground", height = 0.0 }}
 response = {{ kind = "restitution", cr = 0.2, friction = 0.5 }}

@@ -15,16 +15,42 @@ import sys
 import bpy
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
 
 
-def main(out):
-    import hooke_blender
-    from test_bake import tube
+def tube(name, radius, span, rings, capped):
+    """A tube of 16 sides along x over ``span`` at height 1 m, ``rings`` rings of vertices;
+    closed by a fan at each end when ``capped``."""
+    sides = 16
+    points, faces = [], []
+    for i in range(rings):
+        x = span[0] + (span[1] - span[0]) * i / (rings - 1)
+        for j in range(sides):
+            a = 2.0 * math.pi * j / sides
+            points.append((x, radius * math.sin(a), 1.0 + radius * math.cos(a)))
+    for i in range(rings - 1):
+        for j in range(sides):
+            a, b = i * sides + j, i * sides + (j + 1) % sides
+            faces.append((a, a + sides, b + sides, b))
+    if capped:
+        points += [(span[0], 0.0, 1.0), (span[1], 0.0, 1.0)]
+        first, last = len(points) - 2, len(points) - 1
+        top = (rings - 1) * sides
+        for j in range(sides):
+            faces.append((first, j, (j + 1) % sides))
+            faces.append((last, top + (j + 1) % sides, top + j))
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(points, [], faces)
+    mesh.update()
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
 
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    if not hasattr(bpy.types.Object, "hooke"):
-        hooke_blender.register()
+
+
+def sleeve_scene():
+    """Builds the scene in the current file: the arm (a deforming collider skinned to the
+    bones 'upper' and 'fore' of an armature that bends it by 50° at frame 15 and back by
+    frame 30) and the silk sleeve pinned at its shoulder ring; returns (arm, sleeve)."""
     scene = bpy.context.scene
     scene.frame_start, scene.frame_end = 1, 30
     scene.render.fps = 24
@@ -64,6 +90,17 @@ def main(out):
     sleeve.hooke.substeps = 2
     bpy.context.view_layer.objects.active = sleeve
     bpy.ops.object.shade_smooth()
+    return arm, sleeve
+
+
+def main(out):
+    import hooke_blender
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    if not hasattr(bpy.types.Object, "hooke"):
+        hooke_blender.register()
+    scene = bpy.context.scene
+    arm, sleeve = sleeve_scene()
     assert bpy.ops.hooke.bake() == {"FINISHED"}
 
     for obj, colour in ((arm, (0.8, 0.55, 0.4, 1.0)), (sleeve, (0.15, 0.3, 0.8, 1.0))):

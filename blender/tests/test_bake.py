@@ -24,6 +24,9 @@ from mathutils.bvhtree import BVHTree  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 import hooke_blender  # noqa: E402
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "examples"))
+from sleeve import sleeve_scene  # noqa: E402
 from hooke_blender.scene import to_hooke  # noqa: E402
 
 HOOKE = os.environ.get("HOOKE_BIN")
@@ -53,35 +56,6 @@ def grid(name, size, cuts, location):
     )
     obj = bpy.context.active_object
     obj.name = name
-    return obj
-
-
-def tube(name, radius, span, rings, capped):
-    """A tube of 16 sides along x over ``span`` at height 1 m, ``rings`` rings of vertices;
-    closed by a fan at each end when ``capped``."""
-    sides = 16
-    points, faces = [], []
-    for i in range(rings):
-        x = span[0] + (span[1] - span[0]) * i / (rings - 1)
-        for j in range(sides):
-            a = 2.0 * math.pi * j / sides
-            points.append((x, radius * math.sin(a), 1.0 + radius * math.cos(a)))
-    for i in range(rings - 1):
-        for j in range(sides):
-            a, b = i * sides + j, i * sides + (j + 1) % sides
-            faces.append((a, a + sides, b + sides, b))
-    if capped:
-        points += [(span[0], 0.0, 1.0), (span[1], 0.0, 1.0)]
-        first, last = len(points) - 2, len(points) - 1
-        top = (rings - 1) * sides
-        for j in range(sides):
-            faces.append((first, j, (j + 1) % sides))
-            faces.append((last, top + (j + 1) % sides, top + j))
-    mesh = bpy.data.meshes.new(name)
-    mesh.from_pydata(points, [], faces)
-    mesh.update()
-    obj = bpy.data.objects.new(name, mesh)
-    bpy.context.scene.collection.objects.link(obj)
     return obj
 
 
@@ -187,47 +161,10 @@ def test_a_cloth_falls_on_a_rotating_cube_and_plays_hookes_trajectory(fresh):
 
 
 def test_a_sleeve_on_an_arm_bent_by_its_armature_never_enters_it(fresh):
+    """The docs' example (blender/examples/sleeve.py): a silk sleeve pinned at its shoulder
+    ring on an arm that its armature bends by 50° at the elbow and back."""
     scene = bpy.context.scene
-    scene.frame_start, scene.frame_end = 1, 30
-    scene.render.fps = 24
-    # The arm: a capped tube along x, 1 m long, skinned to two bones meeting at x = 0.
-    arm = tube("Arm", 0.08, (-0.5, 0.5), 21, capped=True)
-    bpy.ops.object.armature_add(location=(-0.5, 0.0, 1.0))
-    rig = bpy.context.active_object
-    bpy.ops.object.mode_set(mode="EDIT")
-    upper = rig.data.edit_bones[0]
-    upper.name = "upper"
-    upper.head, upper.tail = (-0.5, 0.0, 1.0), (0.0, 0.0, 1.0)
-    fore = rig.data.edit_bones.new("fore")
-    fore.head, fore.tail = (0.0, 0.0, 1.0), (0.5, 0.0, 1.0)
-    fore.parent = upper
-    bpy.ops.object.mode_set(mode="OBJECT")
-    rig.location = (0.0, 0.0, 0.0)
-    for name in ("upper", "fore"):
-        arm.vertex_groups.new(name=name)
-    for v in arm.data.vertices:
-        w = min(1.0, max(0.0, (v.co.x + 0.1) / 0.2))
-        arm.vertex_groups["upper"].add([v.index], 1.0 - w, "REPLACE")
-        arm.vertex_groups["fore"].add([v.index], w, "REPLACE")
-    mod = arm.modifiers.new("rig", "ARMATURE")
-    mod.object = rig
-    pose = rig.pose.bones["fore"]
-    pose.rotation_mode = "XYZ"
-    for frame, angle in ((1, 0.0), (15, -50.0), (30, 0.0)):
-        pose.rotation_euler = (0.0, 0.0, math.radians(angle))
-        pose.keyframe_insert("rotation_euler", frame=frame)
-    arm.hooke.kind = "COLLIDER"
-    arm.hooke.motion = "DEFORMING"
-    arm.hooke.friction = 0.5
-    # The sleeve: an open tube around the arm from the shoulder past the elbow.
-    sleeve = tube("Sleeve", 0.12, (-0.45, 0.25), 15, capped=False)
-    shoulder = sleeve.vertex_groups.new(name="shoulder")
-    shoulder.add([v.index for v in sleeve.data.vertices if v.co.x < -0.44], 1.0, "REPLACE")
-    sleeve.hooke.kind = "CLOTH"
-    sleeve.hooke.preset = "silk"
-    sleeve.hooke.pin_group = "shoulder"
-    sleeve.hooke.substeps = 2
-    activate(sleeve)
+    arm, sleeve = sleeve_scene()
     assert bpy.ops.hooke.bake() == {"FINISHED"}
     played = assert_plays_hooke(sleeve)
     _, faces = world_mesh(sleeve)
@@ -310,15 +247,27 @@ def test_a_cancelled_bake_keeps_the_earlier_cache_playing(fresh):
     assert bpy.ops.hooke.bake() == {"FINISHED"}
     cache = hooke_blender.cache_of(cloth)
     before = open(cache, "rb").read()
-    # A long bake, interrupted as Ctrl-C interrupts `blender --background`.
+    # A long bake, interrupted as Ctrl-C interrupts `blender --background` once hooke runs
+    # (its scene is written and its first frame exported).
     scene.frame_end = 2000
     cloth.hooke.substeps = 8
-    timer = threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT))
-    timer.start()
+    folder = os.path.dirname(cache)
+    stop = threading.Event()
+
+    def interrupt():
+        while not stop.wait(0.02):
+            runs = [n for n in os.listdir(folder) if n.startswith(".bake-")]
+            if any(os.path.exists(os.path.join(folder, n, "out.pc2")) for n in runs):
+                os.kill(os.getpid(), signal.SIGINT)
+                return
+
+    watcher = threading.Thread(target=interrupt, daemon=True)
+    watcher.start()
     try:
         assert bpy.ops.hooke.bake() == {"CANCELLED"}
     finally:
-        timer.cancel()
+        stop.set()
+        watcher.join()
     assert open(cache, "rb").read() == before
     assert cloth.modifiers["Hooke"].filepath == cache
     leftovers = [n for n in os.listdir(os.path.dirname(cache)) if n.startswith(".bake-")]
