@@ -26,6 +26,68 @@ pub enum PinPath {
     },
 }
 
+/// A motion's state at one time, found once for all its particles.
+enum At<'a> {
+    /// The keys' pose, and the particles' centre and offsets from it.
+    Keys {
+        rotation: nalgebra::Rotation3<f64>,
+        translate: Vec3,
+        centre: Vec3,
+        offsets: &'a [Vec3],
+    },
+    /// The samples before and after, and the weight of the one after.
+    Track(&'a [Vec3], &'a [Vec3], f64),
+}
+
+impl<'a> At<'a> {
+    fn of(path: &'a PinPath, t: f64) -> Self {
+        match path {
+            PinPath::Keys {
+                centre,
+                offsets,
+                keys,
+            } => {
+                let (rotation, translate) = keys.pose(t);
+                At::Keys {
+                    rotation,
+                    translate,
+                    centre: *centre,
+                    offsets,
+                }
+            }
+            PinPath::Track { samples, interval } => {
+                let last = samples.len() - 1;
+                let s = (t / interval).clamp(0.0, last as f64);
+                let k = (s.floor() as usize).min(last);
+                if k == last {
+                    At::Track(&samples[k], &samples[k], 0.0)
+                } else {
+                    At::Track(&samples[k], &samples[k + 1], s - k as f64)
+                }
+            }
+        }
+    }
+
+    /// Where particle `j` of the motion is.
+    fn position(&self, j: usize) -> Vec3 {
+        match self {
+            At::Keys {
+                rotation,
+                translate,
+                centre,
+                offsets,
+            } => centre + translate + rotation * offsets[j],
+            At::Track(a, b, w) => {
+                if *w == 0.0 {
+                    a[j]
+                } else {
+                    a[j] + (b[j] - a[j]) * *w
+                }
+            }
+        }
+    }
+}
+
 /// Pinned particles that follow a motion (docs/physics.md §1.2).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PinMotion {
@@ -61,35 +123,12 @@ impl PinMotion {
     }
 
     /// Where each particle is at time `t`, in the order of [`PinMotion::particles`].
-    pub fn positions(&self, t: f64) -> Box<dyn Iterator<Item = (usize, Vec3)> + '_> {
-        let ids = self.particles.iter().map(|&i| i as usize);
-        match &self.path {
-            PinPath::Keys {
-                centre,
-                offsets,
-                keys,
-            } => {
-                let (rotation, translate) = keys.pose(t);
-                Box::new(
-                    ids.zip(offsets)
-                        .map(move |(i, o)| (i, centre + translate + rotation * o)),
-                )
-            }
-            PinPath::Track { samples, interval } => {
-                let last = samples.len() - 1;
-                let s = (t / interval).clamp(0.0, last as f64);
-                let k = (s.floor() as usize).min(last);
-                let (a, b, w) = if k == last {
-                    (&samples[k], &samples[k], 0.0)
-                } else {
-                    (&samples[k], &samples[k + 1], s - k as f64)
-                };
-                Box::new(
-                    ids.zip(a.iter().zip(b))
-                        .map(move |(i, (a, b))| (i, if w == 0.0 { *a } else { a + (b - a) * w })),
-                )
-            }
-        }
+    pub fn positions(&self, t: f64) -> impl Iterator<Item = (usize, Vec3)> + '_ {
+        let at = At::of(&self.path, t);
+        self.particles
+            .iter()
+            .enumerate()
+            .map(move |(j, &i)| (i as usize, at.position(j)))
     }
 
     /// The times at which the motion turns (its keys or samples), in order.
