@@ -104,7 +104,8 @@ spacing = {spacing}
 
 /// A cache that does not fit is refused, naming the key, the file and what was expected:
 /// a point count other than the mesh's or the body's, keys beside a cache, a cache without
-/// its frame rate, a cache on a shape that cannot deform, a cache that tears the mesh,
+/// its frame rate, a cache on a shape that cannot deform, a cache that tears the mesh, a
+/// penalty on an open mesh that deforms,
 /// pins that follow a cache on a body with no pins, and a cache that is not a file.
 #[test]
 fn caches_that_do_not_fit_are_refused_by_name() {
@@ -230,5 +231,23 @@ response = {{ kind = "restitution", cr = 0.0, friction = 0.5 }}
             );
         }
     }
+    // A penalty needs an inside: an open sheet that deforms cannot give one.
+    let text = scene(
+        &format!("{plane}\nmotion = {{ cache = \"plane.pc2\", fps = 50.0 }}"),
+        "",
+    )
+    .replace(
+        r#"kind = "restitution", cr = 0.0, friction = 0.5"#,
+        r#"kind = "penalty", kc = 1000.0, dc = 1.0"#,
+    );
+    let e = hooke_scene::parse_scene(&text, "bad.toml")
+        .unwrap()
+        .build(&dir)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("collider[0].shape.path") && e.contains("penalty"),
+        "{e}"
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }

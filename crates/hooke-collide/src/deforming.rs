@@ -140,6 +140,11 @@ impl DeformingMesh {
         })
     }
 
+    /// Whether every piece is closed (a solid).
+    pub fn is_closed(&self) -> bool {
+        self.now.mesh.is_closed()
+    }
+
     /// The cache it follows.
     pub fn cache(&self) -> &VertexCache {
         &self.cache

@@ -87,19 +87,13 @@ pub(crate) fn moving(
     Ok(Box::new(hooke_core::Moving::new(shape, pivot, keys)))
 }
 
-/// The keys of the motion at `key` (a collider's `motion`, a body's `pin_motion`), checked;
-/// a bad one is refused as `key.keys`, and a motion that gives `cache` as well, or
-/// `fps` without it, by those keys.
+/// The keys of the motion at `key` (a collider's `motion`, a body's `pin_motion`) that has
+/// no `cache` ([`cache_of`] is asked first), checked; a bad one is refused as `key.keys`,
+/// and `fps` without a cache as `key.fps`.
 pub(crate) fn keyframes(
     motion: &crate::spec::MotionSpec,
     key: &str,
 ) -> Result<hooke_core::Keyframes, BuildError> {
-    if motion.cache.is_some() && !motion.keys.is_empty() {
-        return Err(invalid(
-            format!("{key}.cache"),
-            "a motion follows `keys` or a `cache`, not both: remove one",
-        ));
-    }
     if motion.fps.is_some() && motion.cache.is_none() {
         return Err(invalid(
             format!("{key}.fps"),
@@ -139,12 +133,13 @@ pub(crate) fn cache_of<'a>(
 
 /// A mesh collider animated by the vertex cache at `cache` (relative to `base`), played at
 /// `fps`: the mesh is read as written (every vertex in the file's order, which the cache
-/// follows) and placed as the scene places it.
+/// follows) and placed as the scene places it; with `solid` (a penalty response) every
+/// piece of it must be closed.
 pub(crate) fn deforming(
     spec: &ColliderShapeSpec,
     (cache, fps): (&str, f64),
     key: &str,
-    base: &Path,
+    (base, solid): (&Path, bool),
 ) -> Result<hooke_collide::DeformingMesh, BuildError> {
     let ColliderShapeSpec::Mesh {
         path,
@@ -174,14 +169,23 @@ pub(crate) fn deforming(
     let at = base.join(cache);
     let frames = hooke_collide::VertexCache::read(&at, mesh.positions.len(), fps, &placement)
         .map_err(mesh_error("motion.cache"))?;
-    hooke_collide::DeformingMesh::new(
+    let deforming = hooke_collide::DeformingMesh::new(
         format!("deforming mesh {path}"),
         &mesh,
         &placement,
         frames,
         &at,
     )
-    .map_err(mesh_error("motion.cache"))
+    .map_err(mesh_error("motion.cache"))?;
+    if solid && !deforming.is_closed() {
+        return Err(invalid(
+            format!("{key}.shape.path"),
+            "a penalty collider needs an inside, and this mesh has an open piece: give a \
+             closed mesh, or a restitution or stick response (which catch crossings of open \
+             sheets)",
+        ));
+    }
+    Ok(deforming)
 }
 
 pub(crate) fn build_collider(

@@ -54,7 +54,7 @@ impl SceneSpec {
                 None => None,
             };
             if let Some(cache) = cache {
-                let mesh = deforming(&spec.shape, cache, &key, base)?;
+                let mesh = deforming(&spec.shape, cache, &key, (base, solid))?;
                 geometry.push(ColliderGeometry::Mesh(mesh.triangles_at(0.0)));
                 animations.push(Some(Arc::new(mesh.clone())));
                 slots.push(ColliderSlot {
