@@ -70,8 +70,9 @@ impl DeformingMesh {
         path: &Path,
     ) -> Result<Self, MeshError> {
         if mesh.faces.is_empty() {
-            return Err(MeshError::Empty {
+            return Err(MeshError::Cache {
                 path: path.to_path_buf(),
+                reason: "the mesh it animates has no face (expected an OBJ with 'f' lines)".into(),
             });
         }
         let placed: Vec<Vec3> = mesh.positions.iter().map(|p| placement.apply(p)).collect();

@@ -166,6 +166,9 @@ pub(crate) fn deforming(
     let (text, full) = mesh_text(path, base).map_err(mesh_error("shape.path"))?;
     let mesh = hooke_collide::PolygonMesh::parse(&text, &full, crate::limits::MAX_PARTICLES)
         .map_err(mesh_error("shape.path"))?;
+    if mesh.faces.is_empty() {
+        return Err(mesh_error("shape.path")(MeshError::Empty { path: full }));
+    }
     let at = base.join(cache);
     let frames = hooke_collide::VertexCache::read(&at, mesh.positions.len(), fps, &placement)
         .map_err(mesh_error("motion.cache"))?;
