@@ -6,10 +6,11 @@
 //! crossings by the analytic shapes the caches were made from, not by the solver's own
 //! detection.
 
+use crate::meshes::{folder, obj};
 use hooke_core::Vec3;
 use hooke_scene::Scene;
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 const G: f64 = 9.81;
 
@@ -24,24 +25,9 @@ kd = 0.02
 ks = 15.0
 kd = 0.005";
 
-/// A fresh folder for one test's files.
-pub(crate) fn folder(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("hooke-deforming-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// Writes an OBJ of `vertices` and `faces` (0-based corners).
-pub(crate) fn write_obj(path: &Path, vertices: &[Vec3], faces: &[Vec<usize>]) {
-    let mut s = String::new();
-    for v in vertices {
-        s += &format!("v {} {} {}\n", v.x, v.y, v.z);
-    }
-    for f in faces {
-        let corners: Vec<String> = f.iter().map(|i| (i + 1).to_string()).collect();
-        s += &format!("f {}\n", corners.join(" "));
-    }
-    std::fs::write(path, s).unwrap();
+/// Writes the OBJ of `vertices` and `faces` (0-based corners) at `path`.
+fn write_obj(path: &Path, vertices: &[Vec3], faces: &[Vec<u32>]) {
+    std::fs::write(path, obj(vertices, faces)).unwrap();
 }
 
 /// Writes a PC2 of `samples` (each a position per vertex), start frame 0, sampling 1.
@@ -62,12 +48,10 @@ pub(crate) fn write_pc2(path: &Path, samples: &[Vec<Vec3>]) {
     std::fs::write(path, b).unwrap();
 }
 
-/// Builds the scene `text` whose files are in `dir`.
+/// Builds the scene `text` whose files are in `dir` ([`crate::meshes::build`]), which
+/// must build.
 pub(crate) fn build(text: &str, dir: &Path) -> Scene {
-    hooke_scene::parse_scene(text, "deforming.toml")
-        .unwrap()
-        .build(dir)
-        .unwrap()
+    crate::meshes::build(text, dir).unwrap()
 }
 
 /// A 2 m square in y = 0 (one quad) and its cache at 50 fps for 1.2 s, each sample the
@@ -121,7 +105,7 @@ motion = {{ cache = "plane.pc2", fps = 50.0 }}
 /// symplectic Euler and under block descent at a frame a step.
 #[test]
 fn a_particle_on_a_rising_mesh_plane_rises_with_it() {
-    let dir = folder("rise");
+    let dir = folder("deforming-rise");
     moving_plane(&dir, |t| Vec3::new(0.0, 0.2 * t, 0.0));
     for run in [("symplectic", 1e-3), ("vbd", 1.0 / 60.0)] {
         let mut scene = point_on_plane(&dir, Vec3::new(0.1, 1e-3, 0.2), 0.5, run);
@@ -149,7 +133,7 @@ fn a_particle_on_a_rising_mesh_plane_rises_with_it() {
 /// two steps a factor of 8 apart.
 #[test]
 fn a_particle_on_a_sliding_mesh_plane_is_carried_as_coulomb_says() {
-    let dir = folder("slide");
+    let dir = folder("deforming-slide");
     let (u, mu) = (0.5, 0.2);
     moving_plane(&dir, |t| Vec3::new(u * t, 0.0, 0.0));
     for dt in [1e-3, 1.25e-4] {
@@ -178,7 +162,7 @@ fn a_particle_on_a_sliding_mesh_plane_is_carried_as_coulomb_says() {
 }
 
 /// A UV sphere of `rings` × `sectors` (poles fanned, quads between), unit radius.
-fn unit_sphere(rings: usize, sectors: usize) -> (Vec<Vec3>, Vec<Vec<usize>>) {
+fn unit_sphere(rings: usize, sectors: usize) -> (Vec<Vec3>, Vec<Vec<u32>>) {
     let mut v = vec![Vec3::new(0.0, 1.0, 0.0)];
     for i in 1..rings {
         let th = PI * i as f64 / rings as f64;
@@ -192,7 +176,7 @@ fn unit_sphere(rings: usize, sectors: usize) -> (Vec<Vec3>, Vec<Vec<usize>>) {
         }
     }
     v.push(Vec3::new(0.0, -1.0, 0.0));
-    let at = |i: usize, j: usize| 1 + (i - 1) * sectors + j % sectors;
+    let at = |i: usize, j: usize| (1 + (i - 1) * sectors + j % sectors) as u32;
     let mut f = Vec::new();
     for j in 0..sectors {
         f.push(vec![0, at(1, j + 1), at(1, j)]);
@@ -202,7 +186,7 @@ fn unit_sphere(rings: usize, sectors: usize) -> (Vec<Vec3>, Vec<Vec<usize>>) {
             f.push(vec![at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)]);
         }
     }
-    let last = v.len() - 1;
+    let last = v.len() as u32 - 1;
     for j in 0..sectors {
         f.push(vec![last, at(rings - 1, j), at(rings - 1, j + 1)]);
     }
@@ -292,7 +276,7 @@ fn ball_depth(scene: &Scene, t: f64) -> f64 {
 /// plus the thickness when the ball is largest (t = 1.5 s).
 #[test]
 fn a_cloth_on_a_swelling_ball_never_enters_it() {
-    let dir = folder("swell");
+    let dir = folder("deforming-swell");
     for (n, run) in [(24, ("vbd", 1.0 / 60.0)), (12, ("symplectic", 2e-4))] {
         let mut scene = cloth_on_swelling_ball(&dir, n, run);
         let steps = (2.0 / run.1).round() as u64;
@@ -340,14 +324,14 @@ fn bending_tube(dir: &Path) {
     }
     v.push(Vec3::new(-0.6, 0.5, 0.0));
     v.push(Vec3::new(0.6, 0.5, 0.0));
-    let at = |i: usize, j: usize| i * sides + j % sides;
+    let at = |i: usize, j: usize| (i * sides + j % sides) as u32;
     let mut f = Vec::new();
     for i in 0..rings - 1 {
         for j in 0..sides {
             f.push(vec![at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)]);
         }
     }
-    let (left, right) = (v.len() - 2, v.len() - 1);
+    let (left, right) = (v.len() as u32 - 2, v.len() as u32 - 1);
     for j in 0..sides {
         f.push(vec![left, at(0, j + 1), at(0, j)]);
         f.push(vec![right, at(rings - 1, j), at(rings - 1, j + 1)]);
@@ -379,7 +363,7 @@ fn bending_tube(dir: &Path) {
 /// arm down: at 1 s it is below the elbow's height by at least 0.15 m.
 #[test]
 fn a_sheet_on_a_bending_tube_never_crosses_it() {
-    let dir = folder("tube");
+    let dir = folder("deforming-tube");
     bending_tube(&dir);
     for (run, every) in [(("vbd", 1.0 / 60.0), 1), (("symplectic", 2e-4), 84)] {
         let scene = |duration: f64| {
