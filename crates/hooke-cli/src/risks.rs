@@ -99,17 +99,7 @@ impl Tunnelling {
 /// A mesh its cache deforms: the fastest any vertex moves between two samples.
 fn collider_speed(scene: &Scene, k: usize) -> f64 {
     if let Some(Some(animation)) = scene.animations.get(k) {
-        let cache = animation.cache();
-        return (1..cache.len())
-            .flat_map(|s| {
-                cache
-                    .sample(s - 1)
-                    .iter()
-                    .zip(cache.sample(s))
-                    .map(|(a, b)| (b - a).norm())
-            })
-            .fold(0.0, f64::max)
-            / cache.interval();
+        return animation.cache().speed();
     }
     let Some(keys) = scene.spec.colliders[k]
         .motion

@@ -168,6 +168,15 @@ impl VertexCache {
         self.interval
     }
 
+    /// The fastest any vertex moves between two samples, m/s (zero for one sample).
+    pub fn speed(&self) -> f64 {
+        self.samples
+            .windows(2)
+            .flat_map(|w| w[0].iter().zip(&w[1]).map(|(a, b)| (b - a).norm()))
+            .fold(0.0, f64::max)
+            / self.interval
+    }
+
     /// The time of the last sample, seconds.
     pub fn duration(&self) -> f64 {
         self.interval * (self.samples.len() - 1) as f64

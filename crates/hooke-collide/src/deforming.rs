@@ -13,6 +13,7 @@
 use crate::cache::VertexCache;
 use crate::obj::{MeshError, MeshPart, Placement};
 use crate::polygons::PolygonMesh;
+use crate::shells::{shells, welded};
 use crate::trimesh::TriMeshCollider;
 use hooke_core::{Collider, Contact, Feature, Vec3};
 use std::collections::HashMap;
@@ -222,48 +223,28 @@ fn surface(
     TriMeshCollider::exact(label.to_string(), parts, path)
 }
 
-/// Per position, its welded id (one per distinct position, by exact bits: the copies of
-/// one corner a file repeats), and per id the first position that has it.
+/// Per position, its welded id ([`welded`]: the copies of one corner a file repeats), and
+/// per id the first position that has it.
 fn weld(x: &[Vec3]) -> (Vec<u32>, Vec<u32>) {
-    let mut seen: HashMap<[u64; 3], u32> = HashMap::new();
+    let ids = welded(x);
     let mut first = Vec::new();
-    let ids = x
-        .iter()
-        .enumerate()
-        .map(|(i, v)| {
-            let key = [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
-            *seen.entry(key).or_insert_with(|| {
-                first.push(i as u32);
-                first.len() as u32 - 1
-            })
-        })
-        .collect();
+    for (i, &id) in ids.iter().enumerate() {
+        // Ids are numbered as positions first appear: a new one is the next number.
+        if id as usize == first.len() {
+            first.push(i as u32);
+        }
+    }
     (ids, first)
 }
 
-/// The connected pieces of `triangles` (over `count` welded vertices), each with its own
-/// vertices, in the order of their first triangle.
+/// The connected pieces of `triangles` (over `count` welded vertices, [`shells`]), each
+/// with its own vertices, in the order of their first triangle.
 fn pieces(triangles: &[[u32; 3]], count: usize) -> Vec<Piece> {
-    let mut parent: Vec<u32> = (0..count as u32).collect();
-    fn root(parent: &mut [u32], mut k: u32) -> u32 {
-        while parent[k as usize] != k {
-            parent[k as usize] = parent[parent[k as usize] as usize];
-            k = parent[k as usize];
-        }
-        k
-    }
-    for t in triangles {
-        let a = root(&mut parent, t[0]);
-        for &i in &t[1..] {
-            let b = root(&mut parent, i);
-            parent[b as usize] = a;
-        }
-    }
+    let shell = shells(triangles, count);
     let mut index: HashMap<u32, usize> = HashMap::new();
     let mut out: Vec<(Piece, HashMap<u32, u32>)> = Vec::new();
-    for t in triangles {
-        let r = root(&mut parent, t[0]);
-        let k = *index.entry(r).or_insert_with(|| {
+    for (t, s) in triangles.iter().zip(shell) {
+        let k = *index.entry(s).or_insert_with(|| {
             out.push((
                 Piece {
                     vertices: Vec::new(),

@@ -5,9 +5,9 @@
 use hooke_core::Vec3;
 use std::collections::HashMap;
 
-/// One id per distinct position: OBJ files repeat vertices per face group, and the
-/// copies of one corner must count as one.
-fn welded(vertices: &[Vec3]) -> Vec<u32> {
+/// One id per distinct position, numbered in the order positions first appear: OBJ files
+/// repeat vertices per face group, and the copies of one corner must count as one.
+pub(crate) fn welded(vertices: &[Vec3]) -> Vec<u32> {
     let mut weld: HashMap<[u64; 3], u32> = HashMap::new();
     vertices
         .iter()
@@ -39,26 +39,11 @@ pub fn signed_volume(vertices: &[Vec3], triangles: &[[u32; 3]]) -> f64 {
 /// cloth above it would be pulled through its top.
 pub(crate) fn outward(vertices: &[Vec3], mut triangles: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
     let ids = welded(vertices);
-    // Union-find over welded corners.
-    let mut parent: Vec<u32> = (0..ids.len() as u32).collect();
-    fn root(parent: &mut [u32], mut k: u32) -> u32 {
-        while parent[k as usize] != k {
-            parent[k as usize] = parent[parent[k as usize] as usize];
-            k = parent[k as usize];
-        }
-        k
-    }
-    for t in &triangles {
-        let a = root(&mut parent, ids[t[0] as usize]);
-        for &i in &t[1..] {
-            let b = root(&mut parent, ids[i as usize]);
-            parent[b as usize] = a;
-        }
-    }
-    let shell: Vec<u32> = triangles
+    let corners: Vec<[u32; 3]> = triangles
         .iter()
-        .map(|t| root(&mut parent, ids[t[0] as usize]))
+        .map(|t| t.map(|i| ids[i as usize]))
         .collect();
+    let shell = shells(&corners, ids.len());
     let mut volume: HashMap<u32, f64> = HashMap::new();
     for (t, &s) in triangles.iter().zip(&shell) {
         *volume.entry(s).or_default() += signed_volume(vertices, std::slice::from_ref(t));
@@ -69,6 +54,27 @@ pub(crate) fn outward(vertices: &[Vec3], mut triangles: Vec<[u32; 3]>) -> Vec<[u
         }
     }
     triangles
+}
+
+/// Per triangle of `triangles` (corners numbered below `count`), the shell it belongs to:
+/// the triangles joined through shared corners share one number (a union-find's root).
+pub(crate) fn shells(triangles: &[[u32; 3]], count: usize) -> Vec<u32> {
+    let mut parent: Vec<u32> = (0..count as u32).collect();
+    fn root(parent: &mut [u32], mut k: u32) -> u32 {
+        while parent[k as usize] != k {
+            parent[k as usize] = parent[parent[k as usize] as usize];
+            k = parent[k as usize];
+        }
+        k
+    }
+    for t in triangles {
+        let a = root(&mut parent, t[0]);
+        for &i in &t[1..] {
+            let b = root(&mut parent, i);
+            parent[b as usize] = a;
+        }
+    }
+    triangles.iter().map(|t| root(&mut parent, t[0])).collect()
 }
 
 /// Why a part is not a closed, consistently oriented surface, if it is not: every directed
