@@ -33,29 +33,18 @@ def from_hooke(p, scale):
     return Vector((p[0] / scale, -p[2] / scale, p[1] / scale))
 
 
-def evaluated_positions(obj, depsgraph, skip=None):
+def evaluated_positions(obj, depsgraph):
     """``obj``'s evaluated mesh now: its vertices in world coordinates (Blender's), in the
-    mesh's order, and its faces. ``skip`` names a modifier left out (an earlier bake's)."""
-    mod = obj.modifiers.get(skip) if skip else None
-    shown = None
-    if mod is not None:
-        shown = mod.show_viewport
-        mod.show_viewport = False
-        depsgraph.update()
+    mesh's order, its faces, and its world matrix."""
+    ev = obj.evaluated_get(depsgraph)
+    mesh = ev.to_mesh()
     try:
-        ev = obj.evaluated_get(depsgraph)
-        mesh = ev.to_mesh()
-        try:
-            world = ev.matrix_world.copy()
-            points = [world @ v.co for v in mesh.vertices]
-            faces = [tuple(p.vertices) for p in mesh.polygons]
-        finally:
-            ev.to_mesh_clear()
+        world = ev.matrix_world.copy()
+        points = [world @ v.co for v in mesh.vertices]
+        faces = [tuple(p.vertices) for p in mesh.polygons]
     finally:
-        if mod is not None:
-            mod.show_viewport = shown
-            depsgraph.update()
-    return points, faces
+        ev.to_mesh_clear()
+    return points, faces, world
 
 
 def write_obj(path, points, faces):
@@ -137,7 +126,7 @@ class ColliderTrack:
         if k > 0 and self.motion == "STATIC":
             return
         if k == 0 or self.motion == "DEFORMING":
-            points, faces = evaluated_positions(self.obj, depsgraph)
+            points, faces, _ = evaluated_positions(self.obj, depsgraph)
             points = [to_hooke(p, scale) for p in points]
             if k == 0:
                 self.faces, self.start, self.first = faces, points, number
@@ -232,21 +221,28 @@ def write_scene(context, obj, folder, modifier):
             )
 
     # Every object's evaluated mesh at every frame the bake needs, read once per frame.
+    # An earlier bake's modifier is left out of what is read, and put back as it was.
     start = scene.frame_current
+    earlier = obj.modifiers.get(modifier)
+    shown = earlier.show_viewport if earlier is not None else None
     tracks = [ColliderTrack(c) for c in colliders]
     body_track, matrices = [], []
     try:
+        if earlier is not None:
+            earlier.show_viewport = False
         for k, f in enumerate(span):
             scene.frame_set(f)
             depsgraph = context.evaluated_depsgraph_get()
-            points, faces = evaluated_positions(obj, depsgraph, modifier)
+            points, faces, world = evaluated_positions(obj, depsgraph)
             if k == 0:
                 body_faces = faces
             body_track.append([to_hooke(p, scale) for p in points])
-            matrices.append(obj.evaluated_get(depsgraph).matrix_world.copy())
+            matrices.append(world)
             for track in tracks:
                 track.read(depsgraph, (k, f, k / fps), scale)
     finally:
+        if earlier is not None:
+            earlier.show_viewport = shown
         scene.frame_set(start)
 
     lines = [
