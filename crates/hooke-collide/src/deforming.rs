@@ -18,6 +18,7 @@ use crate::trimesh::TriMeshCollider;
 use hooke_core::{Collider, Contact, Feature, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// How far apart two corners the mesh file puts at one position may drift in the cache
 /// before the surface counts as torn, metres: f32 rounding of a metre-sized scene.
@@ -39,15 +40,43 @@ struct Pose {
     mesh: TriMeshCollider,
 }
 
+/// What moves a deforming mesh, without its poses: the cache, the welded corners and the
+/// pieces; shared with whoever draws it ([`DeformingMesh::animation`]).
+#[derive(Debug)]
+pub struct MeshAnimation {
+    cache: VertexCache,
+    /// Per welded id, the file vertex that stands for it.
+    first: Vec<u32>,
+    pieces: Vec<Piece>,
+}
+
+impl MeshAnimation {
+    /// The cache it follows.
+    pub fn cache(&self) -> &VertexCache {
+        &self.cache
+    }
+
+    /// The surface's triangles at time `t`, for drawing.
+    pub fn triangles_at(&self, t: f64) -> Vec<[Vec3; 3]> {
+        let mut x = Vec::new();
+        self.cache.at(t, &mut x);
+        self.pieces
+            .iter()
+            .flat_map(|p| {
+                p.triangles
+                    .iter()
+                    .map(|tri| tri.map(|i| x[self.first[p.vertices[i as usize] as usize] as usize]))
+            })
+            .collect()
+    }
+}
+
 /// A mesh collider animated by a vertex cache (see the module's documentation).
 #[derive(Clone, Debug)]
 pub struct DeformingMesh {
     label: String,
     path: PathBuf,
-    cache: VertexCache,
-    /// Per file vertex, its welded id; `first[id]` is the file vertex that stands for it.
-    first: Vec<u32>,
-    pieces: Vec<Piece>,
+    animation: Arc<MeshAnimation>,
     before: Pose,
     now: Pose,
     /// A scratch buffer for the cache's positions.
@@ -133,9 +162,11 @@ impl DeformingMesh {
         Ok(Self {
             label,
             path: path.to_path_buf(),
-            cache,
-            first,
-            pieces,
+            animation: Arc::new(MeshAnimation {
+                cache,
+                first,
+                pieces,
+            }),
             before: start.clone(),
             now: start,
             scratch,
@@ -147,29 +178,16 @@ impl DeformingMesh {
         self.now.mesh.is_closed()
     }
 
-    /// The cache it follows.
-    pub fn cache(&self) -> &VertexCache {
-        &self.cache
-    }
-
-    /// The surface's triangles at time `t`, for drawing.
-    pub fn triangles_at(&self, t: f64) -> Vec<[Vec3; 3]> {
-        let mut x = Vec::new();
-        self.cache.at(t, &mut x);
-        self.pieces
-            .iter()
-            .flat_map(|p| {
-                p.triangles
-                    .iter()
-                    .map(|tri| tri.map(|i| x[self.first[p.vertices[i as usize] as usize] as usize]))
-            })
-            .collect()
+    /// Its cache and pieces, to draw it at any time.
+    pub fn animation(&self) -> Arc<MeshAnimation> {
+        Arc::clone(&self.animation)
     }
 
     /// Every welded vertex's position at `t`.
     fn positions(&mut self, t: f64) -> Vec<Vec3> {
-        self.cache.at(t, &mut self.scratch);
-        self.first
+        self.animation.cache.at(t, &mut self.scratch);
+        self.animation
+            .first
             .iter()
             .map(|&f| self.scratch[f as usize])
             .collect()
@@ -179,7 +197,7 @@ impl DeformingMesh {
         let x = self.positions(t);
         // Every sample was built when the collider was, and a pose between two has the
         // same faces, so this builds; were it ever not to, the surface holds where it was.
-        match surface(&self.label, &self.pieces, &x, &self.path) {
+        match surface(&self.label, &self.animation.pieces, &x, &self.path) {
             Ok(mesh) => Pose { t, x, mesh },
             Err(_) => Pose {
                 t,
@@ -194,7 +212,7 @@ impl DeformingMesh {
         let Some((k, corners, w)) = pose.mesh.locate(p) else {
             return Vec3::zeros();
         };
-        let piece = &self.pieces[k];
+        let piece = &self.animation.pieces[k];
         (0..3)
             .map(|c| {
                 let g = piece.vertices[corners[c] as usize] as usize;
@@ -320,11 +338,11 @@ impl Collider for DeformingMesh {
     }
 
     fn is_moving(&self) -> bool {
-        self.cache.len() > 1
+        self.animation.cache.len() > 1
     }
 
     fn motion_spans(&self) -> Vec<(f64, f64)> {
-        self.cache.spans()
+        self.animation.cache.spans()
     }
 
     /// A material point is a fixed combination of its triangle's corners, so it moves at
@@ -332,20 +350,25 @@ impl Collider for DeformingMesh {
     /// most each corner is from where it started, at the samples within the span and at its
     /// end, over the triangles that start within twice that of the box.
     fn sweep(&self, (t0, t1): (f64, f64), lo: &Vec3, hi: &Vec3) -> f64 {
+        let MeshAnimation {
+            cache,
+            first,
+            pieces,
+        } = &*self.animation;
         let mut start = Vec::new();
-        self.cache.at(t0, &mut start);
+        cache.at(t0, &mut start);
         let mut moved = vec![0.0_f64; start.len()];
         let mut x = Vec::new();
-        for t in self.cache.turns(t0, t1).chain([t1]) {
-            self.cache.at(t, &mut x);
+        for t in cache.turns(t0, t1).chain([t1]) {
+            cache.at(t, &mut x);
             for ((m, a), b) in moved.iter_mut().zip(&start).zip(&x) {
                 *m = m.max((b - a).norm());
             }
         }
         let mut most = 0.0_f64;
-        for piece in &self.pieces {
+        for piece in pieces {
             for tri in &piece.triangles {
-                let corners = tri.map(|i| self.first[piece.vertices[i as usize] as usize] as usize);
+                let corners = tri.map(|i| first[piece.vertices[i as usize] as usize] as usize);
                 let d = corners.iter().map(|&c| moved[c]).fold(0.0, f64::max);
                 if d <= most {
                     continue;
@@ -436,7 +459,7 @@ mod tests {
         // Far from the box, nothing moving near it: no travel.
         let far = (Vec3::repeat(10.0), Vec3::repeat(11.0));
         assert_eq!(m.sweep((0.05, 0.15), &far.0, &far.1), 0.0);
-        assert_eq!(m.triangles_at(0.2)[0][0].y as f32, 0.4);
+        assert_eq!(m.animation().triangles_at(0.2)[0][0].y as f32, 0.4);
     }
 
     #[test]

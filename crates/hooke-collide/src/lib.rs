@@ -44,7 +44,7 @@ mod trimesh;
 pub use box_interior::{BOX_FACES, BoxInterior};
 pub use cache::VertexCache;
 pub use cylinder::Cylinder;
-pub use deforming::DeformingMesh;
+pub use deforming::{DeformingMesh, MeshAnimation};
 pub use obj::{MeshError, MeshPart, Placement, load_obj, parse_obj};
 pub use plane::Plane;
 pub use polygons::{Polygon, PolygonMesh};

@@ -141,7 +141,7 @@ pub struct Scene {
     /// Per collider, in the same order, the vertex animation of a mesh its cache deforms
     /// (`motion = { cache, fps }`), for drawing it where it is: see
     /// [`Scene::collider_triangles_at`].
-    pub animations: Vec<Option<std::sync::Arc<hooke_collide::DeformingMesh>>>,
+    pub animations: Vec<Option<std::sync::Arc<hooke_collide::MeshAnimation>>>,
     /// The particles moved out of velocity-level colliders before the first step, per
     /// collider (see [`hooke_core::Simulation::push_out_start`]); said as warnings.
     pub pushed_out: Vec<hooke_core::PushedOut>,

@@ -15,7 +15,7 @@ use std::sync::Arc;
 pub(super) type Colliders = (
     Vec<ColliderSlot>,
     Vec<ColliderGeometry>,
-    Vec<Option<Arc<hooke_collide::DeformingMesh>>>,
+    Vec<Option<Arc<hooke_collide::MeshAnimation>>>,
 );
 
 impl SceneSpec {
@@ -55,8 +55,8 @@ impl SceneSpec {
             };
             if let Some(cache) = cache {
                 let mesh = deforming(&spec.shape, cache, &key, (base, solid))?;
-                geometry.push(ColliderGeometry::Mesh(mesh.triangles_at(0.0)));
-                animations.push(Some(Arc::new(mesh.clone())));
+                geometry.push(ColliderGeometry::Mesh(mesh.animation().triangles_at(0.0)));
+                animations.push(Some(mesh.animation()));
                 slots.push(ColliderSlot {
                     shape: Box::new(mesh),
                     response: response(&spec.response),
