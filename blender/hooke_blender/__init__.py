@@ -9,10 +9,13 @@ Mesh Cache modifier named ``Hooke``. A bake that fails or is cancelled leaves th
 cache as it was.
 """
 
+import contextlib
 import os
 import re
 import shutil
+import signal
 import tempfile
+import threading
 import time
 
 import bpy
@@ -177,29 +180,60 @@ class Job:
 
     def finish(self, context):
         """Puts the finished run's cache in place (in the object's own coordinates) and
-        plays it; raises when the run failed."""
+        plays it; raises when the run failed.
+
+        Until the cache replaces the earlier one, an interrupt (KeyboardInterrupt) cancels
+        the bake and leaves the earlier one; from then on interrupts are held, so that the
+        new cache, the scene beside it and the modifier change together. Returns whether
+        an interrupt came while they were held."""
         try:
             if self.run.poll() != 0:
                 raise BakeError(f"Object '{self.obj.name}': hooke stopped: {self.run.failure()}")
             scale = context.scene.unit_settings.scale_length or 1.0
-            samples = pc2.read(os.path.join(self.work, "out.pc2"))
+            out = os.path.join(self.work, "out.pc2")
+            samples = pc2.read(out)
             local = [
                 [tuple(m.inverted() @ from_hooke(p, scale)) for p in sample]
                 for m, sample in zip(self.matrices, samples)
             ]
-            pc2.write(self.final, local)
-            # The scene that made it stays beside it, for `hooke run` by hand.
-            kept = os.path.splitext(self.final)[0] + "-scene"
-            shutil.rmtree(kept, ignore_errors=True)
-            os.remove(os.path.join(self.work, "out.pc2"))
-            os.replace(self.work, kept)
+            # Written inside the work folder, on the cache's own file system: the move
+            # below is a rename.
+            staged = os.path.join(self.work, "baked.pc2")
+            pc2.write(staged, local)
+            os.remove(out)
+            with interrupts_held() as held:
+                os.replace(staged, self.final)
+                # The scene that made it stays beside it, for `hooke run` by hand.
+                kept = os.path.splitext(self.final)[0] + "-scene"
+                shutil.rmtree(kept, ignore_errors=True)
+                os.replace(self.work, kept)
+                play(context, self.obj, self.final)
+            return bool(held)
         finally:
             shutil.rmtree(self.work, ignore_errors=True)
-        play(context, self.obj, self.final)
 
     def cancel(self):
         self.run.stop()
         shutil.rmtree(self.work, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def interrupts_held():
+    """Holds Ctrl-C (SIGINT) for the block and yields a list that gets an entry per
+    interrupt held. Only where Python's own handler is in place and on the main thread:
+    elsewhere (Blender's own handler, a worker thread) the block runs as it is."""
+    if (
+        threading.current_thread() is not threading.main_thread()
+        or signal.getsignal(signal.SIGINT) is not signal.default_int_handler
+    ):
+        yield []
+        return
+    held = []
+    signal.signal(signal.SIGINT, lambda *_: held.append(True))
+    try:
+        yield held
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def play(context, obj, path):
@@ -256,27 +290,33 @@ class HOOKE_OT_bake(bpy.types.Operator):
                     shown = percent
                 time.sleep(0.05)
         except KeyboardInterrupt:
-            self.job.cancel()
-            self.report({"WARNING"}, f"Object '{self.job.obj.name}': bake cancelled; the earlier cache is kept")
-            return {"CANCELLED"}
+            return self.cancelled()
         return self.done(context)
 
     def done(self, context):
         try:
-            self.job.finish(context)
+            late = self.job.finish(context)
         except BakeError as e:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
-        self.report({"INFO"}, f"Object '{self.job.obj.name}': baked {self.job.frames} frames")
+        except KeyboardInterrupt:
+            return self.cancelled()
+        name = self.job.obj.name
+        if late:
+            self.report({"WARNING"}, f"Object '{name}': the interrupt came as the bake was put in place; it is kept")
+        self.report({"INFO"}, f"Object '{name}': baked {self.job.frames} frames")
         return {"FINISHED"}
+
+    def cancelled(self):
+        self.job.cancel()
+        self.report({"WARNING"}, f"Object '{self.job.obj.name}': bake cancelled; the earlier cache is kept")
+        return {"CANCELLED"}
 
     def modal(self, context, event):
         wm = context.window_manager
         if event.type == "ESC":
-            self.job.cancel()
             self.end(context)
-            self.report({"WARNING"}, f"Object '{self.job.obj.name}': bake cancelled; the earlier cache is kept")
-            return {"CANCELLED"}
+            return self.cancelled()
         if event.type == "TIMER":
             wm.progress_update(int(1000 * self.job.run.fraction))
             if self.job.run.poll() is not None:

@@ -23,16 +23,22 @@ def write(path, samples):
     through a file beside it that replaces it only once complete."""
     count = len(samples[0]) if samples else 0
     tmp = f"{path}.part"
-    with open(tmp, "wb") as f:
-        f.write(HEADER.pack(MAGIC, 1, count, 0.0, 1.0, len(samples)))
-        for sample in samples:
-            if len(sample) != count:
-                raise CacheError(f"{path}: a sample of {len(sample)} points among ones of {count}")
-            flat = array("f", (c for p in sample for c in p))
-            if sys.byteorder != "little":
-                flat.byteswap()
-            f.write(flat.tobytes())
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "wb") as f:
+            f.write(HEADER.pack(MAGIC, 1, count, 0.0, 1.0, len(samples)))
+            for sample in samples:
+                if len(sample) != count:
+                    raise CacheError(f"{path}: a sample of {len(sample)} points among ones of {count}")
+                flat = array("f", (c for p in sample for c in p))
+                if sys.byteorder != "little":
+                    flat.byteswap()
+                f.write(flat.tobytes())
+        os.replace(tmp, path)
+    except BaseException:
+        # An error or an interrupt half-way leaves neither a part file nor a changed `path`.
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
 
 
 def read(path):
