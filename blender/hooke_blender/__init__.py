@@ -1,7 +1,8 @@
 """Hooke inside Blender: mark a mesh as cloth or jelly and others as colliders, then Bake.
 
 The bake writes the scene Hooke reads (docs/blender.md): the object as a body (its
-vertices in their order), every collider (still, rigidly animated, or deforming: the
+vertices in their order; Bake All: every cloth and jelly of the scene, simulated together,
+each with its own cache), every collider (still, rigidly animated, or deforming: the
 evaluated mesh per frame as a PC2 cache), the scene's frame range, frame rate, gravity and
 units; it runs ``hooke run`` with a progress bar (Esc cancels it; Ctrl-C in ``blender
 --background``) and, once it has finished, puts the cache in place and plays it through a
@@ -141,6 +142,9 @@ class HOOKE_PT_physics(bpy.types.Panel):
             row = layout.row()
             row.operator("hooke.bake")
             row.operator("hooke.free_bake")
+            row = layout.row()
+            row.operator("hooke.bake_all")
+            row.operator("hooke.free_all")
 
 
 def folder_of(obj):
@@ -157,59 +161,95 @@ def cache_of(obj):
     return os.path.join(folder_of(obj), re.sub(r"[^\w.-]", "_", obj.name) + ".pc2")
 
 
-class Job:
-    """One bake of ``obj``: its scene written into a fresh folder beside the cache, and
-    hooke running on it."""
+def bodies_of(context):
+    """Every cloth and jelly of the scene, the active object first when it is one (it sets
+    the integrator and substeps of a bake of them all), the others by name."""
+    active = context.active_object
+    found = sorted(
+        (o for o in context.scene.objects if o.hooke.kind in ("CLOTH", "JELLY")),
+        key=lambda o: (o is not active, o.name),
+    )
+    return found
 
-    def __init__(self, context, obj):
-        self.obj = obj
-        folder = folder_of(obj)
-        os.makedirs(folder, exist_ok=True)
-        self.final = cache_of(obj)
+
+class Job:
+    """One bake of ``objs`` together: their scene written into a fresh folder beside the
+    first one's cache, and hooke running on it."""
+
+    def __init__(self, context, objs):
+        self.objs = objs
+        self.obj = objs[0]
+        folder = folder_of(self.obj)
+        self.finals = [cache_of(o) for o in objs]
+        for final in self.finals:
+            os.makedirs(os.path.dirname(final), exist_ok=True)
         self.work = tempfile.mkdtemp(prefix=".bake-", dir=folder)
         try:
             prefs = context.preferences.addons.get(__package__)
             program = find_hooke(prefs.preferences.program if prefs else "")
-            self.scene, self.frames, self.matrices = write_scene(
-                context, obj, self.work, MODIFIER
+            self.scene, self.frames, self.bodies = write_scene(
+                context, objs, self.work, MODIFIER
             )
-            self.run = Run(program, self.scene, os.path.join(self.work, "out.pc2"))
+            # One body: its cache; several: a folder of one per body, named as the bodies.
+            out = os.path.join(self.work, "out.pc2" if len(objs) == 1 else "out" + os.sep)
+            self.run = Run(program, self.scene, out)
         except BaseException:
             shutil.rmtree(self.work, ignore_errors=True)
             raise
 
-    def finish(self, context):
-        """Puts the finished run's cache in place (in the object's own coordinates) and
-        plays it; raises when the run failed.
+    @property
+    def title(self):
+        """The objects baked, as messages name them: ``Object 'Cloth'``."""
+        names = ", ".join(f"'{o.name}'" for o in self.objs)
+        return f"Object {names}" if len(self.objs) == 1 else f"Objects {names}"
 
-        Until the cache replaces the earlier one, an interrupt (KeyboardInterrupt) cancels
-        the bake and leaves the earlier one; from then on interrupts are held, so that the
-        new cache, the scene beside it and the modifier change together. Returns whether
-        an interrupt came while they were held."""
+    def finish(self, context):
+        """Puts the finished run's caches in place (each in its object's own coordinates)
+        and plays them; raises when the run failed.
+
+        Until the caches replace the earlier ones, an interrupt (KeyboardInterrupt) cancels
+        the bake and leaves the earlier ones; from then on interrupts are held, so that the
+        new caches, the scene beside the first and the modifiers change together. Returns
+        whether an interrupt came while they were held."""
+        staged = []
         try:
             if self.run.poll() != 0:
-                raise BakeError(f"Object '{self.obj.name}': hooke stopped: {self.run.failure()}")
+                raise BakeError(f"{self.title}: hooke stopped: {self.run.failure()}")
             scale = context.scene.unit_settings.scale_length or 1.0
-            out = os.path.join(self.work, "out.pc2")
-            samples = pc2.read(out)
-            local = [
-                [tuple(m.inverted() @ from_hooke(p, scale)) for p in sample]
-                for m, sample in zip(self.matrices, samples)
-            ]
-            # Written inside the work folder, on the cache's own file system: the move
-            # below is a rename.
-            staged = os.path.join(self.work, "baked.pc2")
-            pc2.write(staged, local)
-            os.remove(out)
+            for k, ((name, matrices), final) in enumerate(zip(self.bodies, self.finals)):
+                if len(self.objs) == 1:
+                    out = os.path.join(self.work, "out.pc2")
+                else:
+                    out = os.path.join(self.work, "out", name + ".pc2")
+                samples = pc2.read(out)
+                local = [
+                    [tuple(m.inverted() @ from_hooke(p, scale)) for p in sample]
+                    for m, sample in zip(matrices, samples)
+                ]
+                # Written beside the cache it replaces, on its file system: the move below
+                # is a rename.
+                path = f"{final}.{os.getpid()}-{k}.staged"
+                staged.append(path)
+                pc2.write(path, local)
+                os.remove(out)
             with interrupts_held() as held:
-                os.replace(staged, self.final)
-                # The scene that made it stays beside it, for `hooke run` by hand.
-                kept = os.path.splitext(self.final)[0] + "-scene"
+                for path, final in zip(staged, self.finals):
+                    os.replace(path, final)
+                # The scene that made them stays beside the first one's cache, for
+                # `hooke run` by hand.
+                kept = os.path.splitext(self.finals[0])[0] + "-scene"
                 shutil.rmtree(kept, ignore_errors=True)
                 os.replace(self.work, kept)
-                play(context, self.obj, self.final)
+                # The others' own scenes, from earlier bakes of them alone, made no more.
+                for final in self.finals[1:]:
+                    shutil.rmtree(os.path.splitext(final)[0] + "-scene", ignore_errors=True)
+                for obj, final in zip(self.objs, self.finals):
+                    play(context, obj, final)
             return bool(held)
         finally:
+            for path in staged:
+                if os.path.exists(path):
+                    os.remove(path)
             shutil.rmtree(self.work, ignore_errors=True)
 
     def cancel(self):
@@ -251,25 +291,28 @@ def play(context, obj, path):
     mod.show_render = True
 
 
-class HOOKE_OT_bake(bpy.types.Operator):
-    """Simulate the active object with Hooke over the scene's frame range and play it"""
+class BakeOperator:
+    """What a bake does, whatever it bakes (``objects``): the scene written, hooke run with
+    a progress bar (modal in the UI, polled in the background), the caches put in place."""
 
-    bl_idname = "hooke.bake"
-    bl_label = "Bake"
-
-    @classmethod
-    def poll(cls, context):
-        return context.active_object is not None
+    def objects(self, context):
+        raise NotImplementedError
 
     def execute(self, context):
-        obj = context.active_object
+        objs = self.objects(context)
         try:
-            self.job = Job(context, obj)
+            if not objs:
+                raise BakeError(
+                    f"Scene '{context.scene.name}': no object is a cloth or a jelly (Physics > "
+                    "Hooke > Kind)"
+                )
+            self.job = Job(context, objs)
         except BakeError as e:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
         except KeyboardInterrupt:
-            self.report({"WARNING"}, f"Object '{obj.name}': bake cancelled; the earlier cache is kept")
+            names = ", ".join(f"'{o.name}'" for o in objs)
+            self.report({"WARNING"}, f"Object {names}: bake cancelled; the earlier cache is kept")
             return {"CANCELLED"}
         if bpy.app.background or context.window is None:
             return self.wait(context)
@@ -282,11 +325,12 @@ class HOOKE_OT_bake(bpy.types.Operator):
     def wait(self, context):
         """The bake without a window: polled until done; Ctrl-C cancels it."""
         shown = -1
+        names = ", ".join(f"'{o.name}'" for o in self.job.objs)
         try:
             while self.job.run.poll() is None:
                 percent = int(100 * self.job.run.fraction)
                 if percent // 10 != shown // 10:
-                    print(f"Hooke: baking '{self.job.obj.name}': {percent} %", flush=True)
+                    print(f"Hooke: baking {names}: {percent} %", flush=True)
                     shown = percent
                 time.sleep(0.05)
         except KeyboardInterrupt:
@@ -301,15 +345,15 @@ class HOOKE_OT_bake(bpy.types.Operator):
             return {"CANCELLED"}
         except KeyboardInterrupt:
             return self.cancelled()
-        name = self.job.obj.name
+        title = self.job.title
         if late:
-            self.report({"WARNING"}, f"Object '{name}': the interrupt came as the bake was put in place; it is kept")
-        self.report({"INFO"}, f"Object '{name}': baked {self.job.frames} frames")
+            self.report({"WARNING"}, f"{title}: the interrupt came as the bake was put in place; it is kept")
+        self.report({"INFO"}, f"{title}: baked {self.job.frames} frames")
         return {"FINISHED"}
 
     def cancelled(self):
         self.job.cancel()
-        self.report({"WARNING"}, f"Object '{self.job.obj.name}': bake cancelled; the earlier cache is kept")
+        self.report({"WARNING"}, f"{self.job.title}: bake cancelled; the earlier cache is kept")
         return {"CANCELLED"}
 
     def modal(self, context, event):
@@ -330,6 +374,42 @@ class HOOKE_OT_bake(bpy.types.Operator):
         wm.progress_end()
 
 
+class HOOKE_OT_bake(BakeOperator, bpy.types.Operator):
+    """Simulate the active object with Hooke over the scene's frame range and play it"""
+
+    bl_idname = "hooke.bake"
+    bl_label = "Bake"
+
+    @classmethod
+    def poll(cls, context):
+        return context.active_object is not None
+
+    def objects(self, context):
+        return [context.active_object]
+
+
+class HOOKE_OT_bake_all(BakeOperator, bpy.types.Operator):
+    """Simulate every cloth and jelly of the scene together with Hooke (they collide with
+    each other), each with its own cache; the active one's integrator and substeps apply"""
+
+    bl_idname = "hooke.bake_all"
+    bl_label = "Bake All"
+
+    def objects(self, context):
+        return bodies_of(context)
+
+
+def free(obj):
+    """Removes ``obj``'s bake: its Mesh Cache modifier, its cache and the scene beside it."""
+    mod = obj.modifiers.get(MODIFIER)
+    if mod is not None:
+        obj.modifiers.remove(mod)
+    path = cache_of(obj)
+    if os.path.isfile(path):
+        os.remove(path)
+    shutil.rmtree(os.path.splitext(path)[0] + "-scene", ignore_errors=True)
+
+
 class HOOKE_OT_free_bake(bpy.types.Operator):
     """Remove the active object's Hooke bake: its Mesh Cache modifier and its cache"""
 
@@ -341,18 +421,31 @@ class HOOKE_OT_free_bake(bpy.types.Operator):
         return context.active_object is not None
 
     def execute(self, context):
-        obj = context.active_object
-        mod = obj.modifiers.get(MODIFIER)
-        if mod is not None:
-            obj.modifiers.remove(mod)
-        path = cache_of(obj)
-        if os.path.isfile(path):
-            os.remove(path)
-        shutil.rmtree(os.path.splitext(path)[0] + "-scene", ignore_errors=True)
+        free(context.active_object)
         return {"FINISHED"}
 
 
-CLASSES = (HookePreferences, HookeSettings, HOOKE_PT_physics, HOOKE_OT_bake, HOOKE_OT_free_bake)
+class HOOKE_OT_free_all(bpy.types.Operator):
+    """Remove the Hooke bake of every cloth and jelly of the scene"""
+
+    bl_idname = "hooke.free_all"
+    bl_label = "Free All"
+
+    def execute(self, context):
+        for obj in bodies_of(context):
+            free(obj)
+        return {"FINISHED"}
+
+
+CLASSES = (
+    HookePreferences,
+    HookeSettings,
+    HOOKE_PT_physics,
+    HOOKE_OT_bake,
+    HOOKE_OT_bake_all,
+    HOOKE_OT_free_bake,
+    HOOKE_OT_free_all,
+)
 
 
 def register():

@@ -41,15 +41,16 @@ def find_hooke(configured):
 
 
 class Run:
-    """``hooke run SCENE --export OUT`` in the background, its progress read from its
-    messages."""
+    """``hooke run SCENE --export OUT`` in the background (``OUT`` a ``.pc2`` of the first
+    body, or a folder of one per body), its progress read from its messages."""
 
     def __init__(self, program, scene, out):
         self.out = out
         self.lines = []
         self.fraction = 0.0
+        folder = ["--format", "pc2"] if out.endswith(os.sep) else []
         self.process = subprocess.Popen(
-            [program, "run", scene, "--export", out],
+            [program, "run", scene, "--export", out, *folder],
             cwd=os.path.dirname(scene),
             stdout=subprocess.DEVNULL,
             stderr=subprocess.PIPE,

@@ -176,13 +176,96 @@ class ColliderTrack:
         return lines
 
 
-def write_scene(context, obj, folder, modifier):
-    """Writes the scene of baking ``obj`` into ``folder``: its body, every collider of the
-    scene, and ``scene.toml``; returns the scene file's path, the number of frames and the
-    object's world matrix at each (what its own coordinates are relative to).
-    ``modifier`` is the name of an earlier bake's modifier, left out of what is read."""
-    scene = context.scene
+def body_name(obj, k, taken):
+    """The name body ``k`` gets in the scene: the object's, unless it could not name its own
+    cache file (``hooke run --export DIR/ --format pc2``) or is taken; then ``body-k``."""
+    name = obj.name
+    fit = name and not name.startswith(".") and not any(
+        c in "/\\" or not c.isprintable() for c in name
+    )
+    if not fit or name in taken:
+        name = f"body-{k}"
+        while name in taken:
+            name += "_"
+    taken.add(name)
+    return name
+
+
+def pinned_vertices(obj):
+    """The vertices of ``obj``'s pin group (none without one); refused when the group does
+    not exist or holds no vertex."""
     settings = obj.hooke
+    if settings.kind != "CLOTH" or not settings.pin_group:
+        return []
+    group = obj.vertex_groups.get(settings.pin_group)
+    if group is None:
+        raise BakeError(
+            f"Object '{obj.name}': vertex group '{settings.pin_group}' does not exist "
+            "(Physics > Hooke > Pin Group names one of the object's vertex groups)"
+        )
+    pins = [
+        v.index
+        for v in obj.data.vertices
+        if any(g.group == group.index and g.weight > 0.0 for g in v.groups)
+    ]
+    if not pins:
+        raise BakeError(
+            f"Object '{obj.name}': vertex group '{settings.pin_group}' holds no vertex "
+            "(Physics > Hooke > Pin Group)"
+        )
+    return pins
+
+
+def body_lines(obj, name, files, track, faces, pins, scale, fps):
+    """The scene lines of ``obj`` as body ``name``, its files (``files``: the mesh's and the
+    pins' cache's names) written beside the scene: its evaluated points per frame
+    (``track``, Hooke's), its faces, its pinned vertices."""
+    settings = obj.hooke
+    mesh, pin_cache = files
+    lines = ["", "[[body]]", f"name = {toml_value(name)}"]
+    if settings.kind == "CLOTH":
+        lines.append(f"thickness = {setting(settings.thickness) * scale!r}")
+        lines.append(f"friction = {setting(settings.friction)!r}")
+        if pins:
+            lines.append(f"pins = {toml_value(pins)}")
+            first = track[0]
+            if any(
+                max(abs(a - b) for a, b in zip(sample[i], first[i])) > 0.0
+                for sample in track[1:]
+                for i in pins
+            ):
+                pc2.write(pin_cache, track)
+                lines.append(
+                    f"pin_motion = {{ cache = {toml_value(os.path.basename(pin_cache))}, "
+                    f"fps = {fps!r} }}"
+                )
+        lines += ["", "[body.shape]", 'kind = "mesh"', f"path = {toml_value(os.path.basename(mesh))}", ""]
+        lines += ["[body.material]", f"preset = {toml_value(settings.preset)}"]
+    else:
+        lines.append(f"mass = {setting(settings.mass)!r}")
+        lines += ["", "[body.shape]", 'kind = "solid"', f"path = {toml_value(os.path.basename(mesh))}"]
+        lines.append(f"spacing = {setting(settings.spacing) * scale!r}")
+        for kind, ks in (("structural", 1.0), ("shear", 1.0), ("bend", 0.5)):
+            lines += [
+                "",
+                f"[body.springs.{kind}]",
+                f"ks = {setting(settings.stiffness) * ks!r}",
+                f"kd = {setting(settings.damping)!r}",
+            ]
+    write_obj(mesh, track[0], faces)
+    return lines
+
+
+def write_scene(context, objs, folder, modifier):
+    """Writes the scene of baking ``objs`` together into ``folder``: each as a body (the
+    first sets the integrator and the substeps), every other collider of the scene, and
+    ``scene.toml``. Returns the scene file's path, the number of frames, and per object
+    its body's name and its world matrix at each frame (what its own coordinates are
+    relative to). ``modifier`` is the name of an earlier bake's modifier, left out of what
+    is read."""
+    scene = context.scene
+    lead = objs[0]
+    settings = lead.hooke
     scale = scene.unit_settings.scale_length or 1.0
     span, fps = frames(scene)
     if len(span) < 2:
@@ -190,64 +273,54 @@ def write_scene(context, obj, folder, modifier):
             f"Scene '{scene.name}': its frame range {scene.frame_start}–{scene.frame_end} "
             "has no frame to bake after the first (Output Properties > Frame Range)"
         )
-    if settings.kind not in ("CLOTH", "JELLY"):
-        raise BakeError(
-            f"Object '{obj.name}': Hooke bakes a cloth or a jelly; set Physics > Hooke > Kind"
-        )
-    what = "cloth" if settings.kind == "CLOTH" else "jelly"
-    check_mesh(obj, f"a {what}")
+    for obj in objs:
+        if obj.hooke.kind not in ("CLOTH", "JELLY"):
+            raise BakeError(
+                f"Object '{obj.name}': Hooke bakes a cloth or a jelly; set Physics > Hooke > Kind"
+            )
+        check_mesh(obj, "a cloth" if obj.hooke.kind == "CLOTH" else "a jelly")
     substeps = max(1, settings.substeps)
 
-    colliders = [o for o in scene.objects if o.hooke.kind == "COLLIDER" and o is not obj]
+    colliders = [o for o in scene.objects if o.hooke.kind == "COLLIDER" and o not in objs]
     for c in colliders:
         check_mesh(c, "a collider")
-    pins = []
-    if settings.kind == "CLOTH" and settings.pin_group:
-        group = obj.vertex_groups.get(settings.pin_group)
-        if group is None:
-            raise BakeError(
-                f"Object '{obj.name}': vertex group '{settings.pin_group}' does not exist "
-                "(Physics > Hooke > Pin Group names one of the object's vertex groups)"
-            )
-        pins = [
-            v.index
-            for v in obj.data.vertices
-            if any(g.group == group.index and g.weight > 0.0 for g in v.groups)
-        ]
-        if not pins:
-            raise BakeError(
-                f"Object '{obj.name}': vertex group '{settings.pin_group}' holds no vertex "
-                "(Physics > Hooke > Pin Group)"
-            )
+    pins = [pinned_vertices(obj) for obj in objs]
 
     # Every object's evaluated mesh at every frame the bake needs, read once per frame.
     # An earlier bake's modifier is left out of what is read, and put back as it was.
     start = scene.frame_current
-    earlier = obj.modifiers.get(modifier)
-    shown = earlier.show_viewport if earlier is not None else None
+    earlier = [(m, m.show_viewport) for m in (o.modifiers.get(modifier) for o in objs) if m]
     tracks = [ColliderTrack(c) for c in colliders]
-    body_track, matrices = [], []
+    # Per object: its points (Hooke's) and world matrix at each frame, its faces.
+    bodies = [([], [], []) for _ in objs]
     try:
-        if earlier is not None:
-            earlier.show_viewport = False
+        for m, _ in earlier:
+            m.show_viewport = False
         for k, f in enumerate(span):
             scene.frame_set(f)
             depsgraph = context.evaluated_depsgraph_get()
-            points, faces, world = evaluated_positions(obj, depsgraph)
-            if k == 0:
-                body_faces = faces
-            body_track.append([to_hooke(p, scale) for p in points])
-            matrices.append(world)
+            for obj, (track, matrices, faces) in zip(objs, bodies):
+                points, polygons, world = evaluated_positions(obj, depsgraph)
+                if k == 0:
+                    faces.extend(polygons)
+                track.append([to_hooke(p, scale) for p in points])
+                matrices.append(world)
             for track in tracks:
                 track.read(depsgraph, (k, f, k / fps), scale)
     finally:
-        if earlier is not None:
-            earlier.show_viewport = shown
+        for m, shown in earlier:
+            m.show_viewport = shown
         scene.frame_set(start)
 
+    names = [lead.name] if len(objs) == 1 else []
+    if not names:
+        taken = set()
+        names = [body_name(obj, k, taken) for k, obj in enumerate(objs)]
+    title = f"'{lead.name}'" if len(objs) == 1 else ", ".join(f"'{o.name}'" for o in objs)
     lines = [
-        f"# Hooke scene of the Blender object '{obj.name}', written by the Hooke extension",
-        f"name = {toml_value('blender-' + obj.name)}",
+        f"# Hooke scene of the Blender object{'s' if len(objs) > 1 else ''} {title}, "
+        "written by the Hooke extension",
+        f"name = {toml_value('blender-' + lead.name)}",
         "",
         "[simulation]",
         f"integrator = {toml_value(settings.integrator.lower())}",
@@ -257,39 +330,15 @@ def write_scene(context, obj, folder, modifier):
     ]
     gravity = scene.gravity if scene.use_gravity else Vector((0.0, 0.0, 0.0))
     lines.append(f"gravity = {toml_value([setting(g) + 0.0 for g in to_hooke(gravity, 1.0)])}")
-    if settings.kind == "CLOTH":
+    if any(o.hooke.kind == "CLOTH" for o in objs):
         lines.append("mass_drag = 0.1")
-    lines += ["", "[[body]]", f"name = {toml_value(obj.name)}"]
-    write_obj(os.path.join(folder, "body.obj"), body_track[0], body_faces)
-    if settings.kind == "CLOTH":
-        lines.append(f"thickness = {setting(settings.thickness) * scale!r}")
-        lines.append(f"friction = {setting(settings.friction)!r}")
-        if pins:
-            lines.append(f"pins = {toml_value(pins)}")
-            first = body_track[0]
-            if any(
-                max(abs(a - b) for a, b in zip(sample[i], first[i])) > 0.0
-                for sample in body_track[1:]
-                for i in pins
-            ):
-                pc2.write(os.path.join(folder, "pins.pc2"), body_track)
-                lines.append(f"pin_motion = {{ cache = \"pins.pc2\", fps = {fps!r} }}")
-        lines += ["", "[body.shape]", 'kind = "mesh"', 'path = "body.obj"', ""]
-        lines += ["[body.material]", f"preset = {toml_value(settings.preset)}"]
-    else:
-        lines.append(f"mass = {setting(settings.mass)!r}")
-        lines += ["", "[body.shape]", 'kind = "solid"', 'path = "body.obj"']
-        lines.append(f"spacing = {setting(settings.spacing) * scale!r}")
-        for kind, ks in (("structural", 1.0), ("shear", 1.0), ("bend", 0.5)):
-            lines += [
-                "",
-                f"[body.springs.{kind}]",
-                f"ks = {setting(settings.stiffness) * ks!r}",
-                f"kd = {setting(settings.damping)!r}",
-            ]
+    for k, (obj, name, (track, _, faces)) in enumerate(zip(objs, names, bodies)):
+        stem = "" if k == 0 else f"-{k}"
+        files = (os.path.join(folder, f"body{stem}.obj"), os.path.join(folder, f"pins{stem}.pc2"))
+        lines += body_lines(obj, name, files, track, faces, pins[k], scale, fps)
     for n, track in enumerate(tracks):
         lines += [""] + track.write(folder, n, fps)
     path = os.path.join(folder, "scene.toml")
     with open(path, "w", encoding="utf-8") as f:
         f.write("\n".join(lines) + "\n")
-    return path, len(span), matrices
+    return path, len(span), [(name, matrices) for name, (_, matrices, _) in zip(names, bodies)]

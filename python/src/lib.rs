@@ -35,9 +35,10 @@ create_exception!(
 
 /// The command line's option names in the library's messages, as the Python arguments
 /// that carry the same values.
-const ARGUMENT_NAMES: [(&str, &str); 9] = [
+const ARGUMENT_NAMES: [(&str, &str); 10] = [
     ("--format ply", "format=\"ply\""),
     ("--format obj", "format=\"obj\""),
+    ("--format pc2", "format=\"pc2\""),
     ("--format", "format"),
     ("--export (its mesh)", "export (its mesh)"),
     ("--export", "export path"),
@@ -481,8 +482,8 @@ impl Simulation {
 
     /// Runs the rest of the scene's run (from now to its end) writing its frames as
     /// `hooke run --export` does: `PATH.usda`, `PATH.pc2` (with `body`), or a folder ending
-    /// in `/` with `format` `"ply"` or `"obj"`. Returns what was written. Frame 0 is the
-    /// state now.
+    /// in `/` with `format` `"ply"` or `"obj"` (a file per frame) or `"pc2"` (a point cache
+    /// per body). Returns what was written. Frame 0 is the state now.
     #[pyo3(signature = (path, format = None, body = None))]
     fn export(
         &self,
@@ -495,9 +496,10 @@ impl Simulation {
             None => None,
             Some("ply") => Some(FolderFormat::Ply),
             Some("obj") => Some(FolderFormat::Obj),
+            Some("pc2") => Some(FolderFormat::Pc2),
             Some(other) => {
                 return Err(PyValueError::new_err(format!(
-                    "format: expected \"ply\" or \"obj\", found {other:?}"
+                    "format: expected \"ply\", \"obj\" or \"pc2\", found {other:?}"
                 )));
             }
         };
@@ -505,8 +507,11 @@ impl Simulation {
         // No export replaces a file the simulation was built from.
         let mut claims = hooke::output::claims::Claims::with_inputs(self.inputs.clone());
         target.claim(&mut claims);
-        claims.check().map_err(error)?;
         let mut inner = self.lock()?;
+        target
+            .claim_bodies(&inner.scene, &mut claims)
+            .map_err(error)?;
+        claims.check().map_err(error)?;
         let mut exporter = hooke::export::create(&target, &inner.scene).map_err(error)?;
         let left = inner
             .scene

@@ -243,8 +243,15 @@ def test_export_writes_what_the_command_writes(tmp_path):
     stage = pxr.Usd.Stage.Open(str(tmp_path / "c.usda"))
     assert stage.GetEndTimeCode() == 10
     assert sim.steps_taken == 400
-    with pytest.raises(hooke.HookeError, match='a folder export needs format="ply" or format="obj"'):
+    with pytest.raises(
+        hooke.HookeError,
+        match='a folder export needs format="ply", format="obj" or format="pc2"',
+    ):
         sim.export(str(tmp_path) + "/")
+    # A point cache per body: the chain's one body.
+    said = hooke.load("chain", steps=400, every=40).export(str(tmp_path / "caches") + "/", "pc2")
+    assert "11 samples of body chain" in said, said
+    assert (tmp_path / "caches" / "chain.pc2").stat().st_size == 32 + 11 * 12 * 12
 
 
 def test_stepping_releases_the_gil_and_a_second_thread_is_told_the_simulation_is_busy():

@@ -196,10 +196,12 @@ struct RunArgs {
     gif: Option<PathBuf>,
     /// Export the frames for other tools, the format from the path: FILE.usda (a USD stage,
     /// Y-up, metres, a time code per frame), FILE.pc2 (Blender's point cache of one body,
-    /// with its mesh as FILE.obj beside it) or DIR/ with --format (a file per frame).
+    /// with its mesh as FILE.obj beside it) or DIR/ with --format (a file per frame, or with
+    /// pc2 a point cache per body, DIR/NAME.pc2 and DIR/NAME.obj).
     #[arg(long, value_name = "PATH")]
     export: Option<PathBuf>,
-    /// The files of a folder export: ply (binary, with normals) or obj (with colliders).
+    /// The files of a folder export: ply (binary, with normals) or obj (with colliders), a
+    /// file per frame; or pc2, Blender's point cache per body.
     #[arg(long, requires = "export")]
     format: Option<hooke::export::FolderFormat>,
     /// The body a .pc2 export caches (default: the scene's first).

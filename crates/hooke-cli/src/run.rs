@@ -80,6 +80,11 @@ pub fn run(args: &RunArgs) -> Result<ExitCode> {
         view.range = Some(range);
     }
     let mut scene = source::build_prepared(source, &args.scene)?;
+    // A cache per body is named after the bodies, known only now.
+    if let Some(target) = &export_target {
+        target.claim_bodies(&scene, &mut claims)?;
+        claims.check()?;
+    }
     let estimate = warn_if_unstable(&scene);
     warn_if_tunnelling(&scene);
     warn_if_other_large_step(&scene, &estimate);

@@ -226,6 +226,101 @@ fn a_point_cache_matches_the_trajectory_and_its_mesh_loads_with_tobj() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Two cloths, one dropped onto the other, in one scene: each a 6 × 6 grid.
+const TWO_CLOTHS: &str = r#"
+name = "two"
+[simulation]
+integrator = "symplectic"
+dt = 0.0005
+steps = 800
+every = 80
+[[body]]
+name = "under"
+mass = 0.002
+origin = [0.0, 0.1, 0.0]
+shape = { kind = "grid", size = [6, 6], spacing = 0.05 }
+springs = { structural = { ks = 200.0, kd = 0.05 }, shear = { ks = 100.0, kd = 0.05 }, bend = { ks = 10.0, kd = 0.01 } }
+[[body]]
+name = "over"
+mass = 0.002
+origin = [0.02, 0.2, 0.02]
+shape = { kind = "grid", size = [6, 6], spacing = 0.05 }
+springs = { structural = { ks = 200.0, kd = 0.05 }, shear = { ks = 100.0, kd = 0.05 }, bend = { ks = 10.0, kd = 0.01 } }
+[[collider]]
+shape = { kind = "ground", height = 0.0 }
+response = { kind = "restitution", cr = 0.0, friction = 0.5 }
+"#;
+
+/// `(points, samples)` of a point cache's header.
+fn pc2_header(path: &Path) -> (i32, i32) {
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(&bytes[..12], b"POINTCACHE2\0");
+    let int = |at: usize| i32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
+    (int(16), int(28))
+}
+
+/// `--export DIR/ --format pc2` writes each body's cache from one run, the same bytes as
+/// that body's own `.pc2` export; a body whose name cannot be a file's, or a mesh of the
+/// user's where a cache's would go, refuses the run before anything is written.
+#[test]
+fn a_folder_of_point_caches_holds_every_body_of_one_run() {
+    let dir = scratch("export-pc2-folder");
+    std::fs::write(dir.join("two.toml"), TWO_CLOTHS).unwrap();
+    let said = run(
+        &["run", "two.toml", "--export", "caches/", "--format", "pc2"],
+        &dir,
+    );
+    assert!(said.contains("samples of body under"), "{said}");
+    for body in ["under", "over"] {
+        let cache = dir.join("caches").join(format!("{body}.pc2"));
+        assert_eq!(pc2_header(&cache), (36, 11), "{body}");
+        assert_eq!(text_vertices(&cache.with_extension("obj")), 36);
+        run(
+            &["run", "two.toml", "--export", "alone.pc2", "--body", body],
+            &dir,
+        );
+        assert!(
+            std::fs::read(&cache).unwrap() == std::fs::read(dir.join("alone.pc2")).unwrap(),
+            "{body}: the folder's cache differs from the body's own export"
+        );
+    }
+    // The upper cloth lies on the lower one at the end: the two were simulated together.
+    let last = |body: &str| {
+        let bytes = std::fs::read(dir.join("caches").join(format!("{body}.pc2"))).unwrap();
+        let at = 32 + 10 * 36 * 12 + 14 * 12 + 4;
+        f32::from_le_bytes(bytes[at..at + 4].try_into().unwrap())
+    };
+    let (over, under) = (last("over"), last("under"));
+    assert!(over > under + 0.004 && under < 0.01, "{over} {under}");
+    let named = TWO_CLOTHS.replace("name = \"over\"", "name = \"a/b\"");
+    std::fs::write(dir.join("named.toml"), named).unwrap();
+    let o = hooke(
+        &["run", "named.toml", "--export", "n/", "--format", "pc2"],
+        &dir,
+    );
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("body 'a/b' cannot name its cache, it holds a path separator"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!dir.join("n").exists());
+    std::fs::create_dir(dir.join("mine")).unwrap();
+    std::fs::write(dir.join("mine/over.obj"), "v 0 0 0\n").unwrap();
+    let o = hooke(
+        &["run", "two.toml", "--export", "mine/", "--format", "pc2"],
+        &dir,
+    );
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("was not written by an earlier export"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(file_names(&dir.join("mine")), ["over.obj"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn ply_frames_read_back_with_the_ply_crate() {
     use hooke::export::ply::{PlyFace, PlyVertex};
@@ -397,7 +492,7 @@ fn export_paths_that_make_no_sense_are_refused_before_the_run() {
         ),
         (
             vec!["--export", "frames/"],
-            "a folder export needs --format ply or --format obj",
+            "a folder export needs --format ply, --format obj or --format pc2",
         ),
         (
             vec!["--export", "run.usda", "--format", "ply"],

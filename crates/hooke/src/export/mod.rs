@@ -8,7 +8,10 @@
 //! * `NAME.pc2`: Blender's point cache for one body ([`pc2`]), with `NAME.obj`, the body's
 //!   mesh at the start, beside it;
 //! * `DIR/` with `--format ply` or `--format obj`: a file per frame, `DIR/frame-00000.ply`
-//!   … ([`ply`], [`obj`]).
+//!   … ([`ply`], [`obj`]);
+//! * `DIR/` with `--format pc2`: a point cache per body, `DIR/NAME.pc2` with its mesh
+//!   `DIR/NAME.obj` ([`pc2::Pc2Folder`]), so that bodies simulated together (two garments
+//!   that collide) come into Blender from one run.
 //!
 //! Coordinates are the simulation's: metres, +Y up.
 
@@ -32,6 +35,9 @@ pub enum FolderFormat {
     Ply,
     /// Wavefront OBJ: bodies and colliders as named objects.
     Obj,
+    /// Blender's point cache of every body, `NAME.pc2`, with its mesh `NAME.obj` (not a
+    /// file per frame: a cache per body).
+    Pc2,
 }
 
 impl FolderFormat {
@@ -40,6 +46,7 @@ impl FolderFormat {
         match self {
             Self::Ply => "ply",
             Self::Obj => "obj",
+            Self::Pc2 => "pc2",
         }
     }
 }
@@ -92,6 +99,13 @@ impl Target {
             .map(|e| e.to_string_lossy().to_ascii_lowercase())
             .unwrap_or_default();
         let target = match (folder, ext.as_str(), format) {
+            (true, _, Some(FolderFormat::Pc2)) => {
+                check_output_folder(path, "--export")?;
+                Target::Folder {
+                    dir: path.to_path_buf(),
+                    format: FolderFormat::Pc2,
+                }
+            }
             (true, _, Some(format)) => {
                 check_output_folder(path, "--export")?;
                 Target::Folder {
@@ -100,7 +114,7 @@ impl Target {
                 }
             }
             (true, _, None) => bail_output!(
-                "--export {}: a folder export needs --format ply or --format obj",
+                "--export {}: a folder export needs --format ply, --format obj or --format pc2",
                 path.display()
             ),
             (false, "usda" | "pc2", Some(format)) => bail_output!(
@@ -133,7 +147,7 @@ impl Target {
             }
             _ => bail_output!(
                 "--export {}: expected a file ending in .usda or .pc2, or a folder ending in / \
-                 with --format ply or obj",
+                 with --format ply, obj or pc2",
                 path.display()
             ),
         };
@@ -143,7 +157,8 @@ impl Target {
         Ok(target)
     }
 
-    /// Adds the files and folders this export writes to `claims`.
+    /// Adds the files and folders this export writes to `claims`. A point cache per body is
+    /// claimed once the scene, and so its bodies' names, are known ([`Target::claim_bodies`]).
     pub fn claim(&self, claims: &mut crate::output::claims::Claims) {
         match self {
             Target::Usd(path) => claims.file("--export", path),
@@ -151,8 +166,32 @@ impl Target {
                 claims.file("--export", path);
                 claims.file("--export (its mesh)", &path.with_extension("obj"));
             }
+            Target::Folder {
+                format: FolderFormat::Pc2,
+                ..
+            } => {}
             Target::Folder { dir, format } => claims.frames("--export", dir, format.extension()),
         }
+    }
+
+    /// Adds the files a point cache per body writes for `scene` to `claims` (nothing for
+    /// other exports); refused when a body's name cannot be a file's.
+    pub fn claim_bodies(
+        &self,
+        scene: &Scene,
+        claims: &mut crate::output::claims::Claims,
+    ) -> Result<()> {
+        if let Target::Folder {
+            dir,
+            format: FolderFormat::Pc2,
+        } = self
+        {
+            for (_, path) in pc2::body_paths(dir, scene)? {
+                claims.file("--export", &path);
+                claims.file("--export (its mesh)", &path.with_extension("obj"));
+            }
+        }
+        Ok(())
     }
 }
 
@@ -177,6 +216,10 @@ pub fn create(target: &Target, scene: &Scene) -> Result<Box<dyn crate::Sink + Se
             dir,
             format: FolderFormat::Ply,
         } => Box::new(ply::PlyExport::new(dir, scene)?),
+        Target::Folder {
+            dir,
+            format: FolderFormat::Pc2,
+        } => Box::new(pc2::Pc2Folder::create(dir, scene)?),
     })
 }
 

@@ -13,7 +13,8 @@
 //! own Frame Start (0 by default, while a timeline starts at 1).
 //!
 //! Samples are appended as the run goes; the count in the header is written when the run
-//! ends, at the last complete frame.
+//! ends, at the last complete frame. `--export DIR/ --format pc2` writes one per body
+//! ([`Pc2Folder`]).
 
 use crate::error::{Context, Result, bail_output};
 use crate::output::OutputFile;
@@ -211,6 +212,101 @@ impl crate::Sink for Pc2Export {
             self.count,
             self.path.with_extension("obj").display()
         ))
+    }
+}
+
+/// Why `name` cannot name a body's cache in a folder (none when it can): a file name of
+/// its own, with no separator, control character or leading dot.
+fn unfit_file_name(name: &str) -> Option<&'static str> {
+    if name.is_empty() {
+        Some("it is empty")
+    } else if name.starts_with('.') {
+        Some("it starts with a dot (a hidden file, or the folder itself)")
+    } else if name.contains(['/', '\\']) {
+        Some("it holds a path separator")
+    } else if name.chars().any(char::is_control) {
+        Some("it holds a control character")
+    } else {
+        None
+    }
+}
+
+/// Each body of `scene` with the cache it gets in `dir`: `DIR/NAME.pc2`; refused, naming
+/// the body, when a name cannot be a file's.
+pub fn body_paths(dir: &Path, scene: &Scene) -> Result<Vec<(String, PathBuf)>> {
+    if scene.bodies.is_empty() {
+        bail_output!("--export: scene {} has no body to cache", scene.spec.name);
+    }
+    scene
+        .bodies
+        .iter()
+        .map(|b| match unfit_file_name(&b.name) {
+            Some(why) => bail_output!(
+                "--export {} --format pc2: body '{}' cannot name its cache, {why}: rename the \
+                 body, or export it alone with --export FILE.pc2 --body NAME",
+                dir.display(),
+                b.name.escape_debug()
+            ),
+            None => Ok((b.name.clone(), dir.join(format!("{}.pc2", b.name)))),
+        })
+        .collect()
+}
+
+/// `--export DIR/ --format pc2`: a point cache per body, `DIR/NAME.pc2` with its mesh
+/// `DIR/NAME.obj`, each as [`Pc2Export`] writes one, from one run (bodies that collide with
+/// each other, baked together).
+pub struct Pc2Folder {
+    caches: Vec<Pc2Export>,
+    _lock: crate::output::lock::FolderLock,
+}
+
+impl Pc2Folder {
+    /// Starts the caches of every body of `scene` in `dir` (made if missing), each checked
+    /// as a `.pc2` export's file is: no device, link or stream, and no mesh beside it that
+    /// an earlier export did not write.
+    pub fn create(dir: &Path, scene: &Scene) -> Result<Self> {
+        let paths = body_paths(dir, scene)?;
+        crate::output::create_folder(dir, "--export")?;
+        let lock = crate::output::lock::FolderLock::take(dir, "--export")?;
+        for (_, path) in &paths {
+            if crate::output::check_output_file(path, "--export", &["pc2"])?.is_stream() {
+                bail_output!(
+                    "--export {}: a point cache needs a regular file, not a stream",
+                    path.display()
+                );
+            }
+            let mesh = path.with_extension("obj");
+            crate::output::check_named(&mesh, "--export (its mesh)")?;
+            crate::output::check_output_file(&mesh, "--export (its mesh)", &["obj"])?;
+            refuse_foreign_mesh(path, &mesh)?;
+        }
+        let caches = paths
+            .iter()
+            .map(|(name, path)| Pc2Export::create(path, Some(name), scene))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Self {
+            caches,
+            _lock: lock,
+        })
+    }
+}
+
+impl crate::Sink for Pc2Folder {
+    /// Appends frame `frame` of `scene` to every body's cache.
+    fn frame(&mut self, frame: u64, scene: &Scene) -> Result<()> {
+        self.caches
+            .iter_mut()
+            .try_for_each(|c| crate::Sink::frame(c, frame, scene))
+    }
+
+    /// Puts every cache in place.
+    fn finish(self: Box<Self>) -> Result<String> {
+        let Self { caches, _lock } = *self;
+        let written = caches
+            .into_iter()
+            .map(|c| crate::Sink::finish(Box::new(c)))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(written.join("; "))
     }
 }
 
