@@ -73,6 +73,17 @@ pub(crate) fn moving_plane(dir: &Path, motion: impl Fn(f64) -> Vec3) {
 /// One particle at rest at `at` over the moving plane, with Coulomb `mu`, stepped by
 /// `integrator` at `dt`.
 fn point_on_plane(dir: &Path, at: Vec3, mu: f64, (integrator, dt): (&str, f64)) -> Scene {
+    point_on_plane_from(dir, "plane.pc2", at, mu, (integrator, dt))
+}
+
+/// [`point_on_plane`] with the plane's motion read from `cache`.
+fn point_on_plane_from(
+    dir: &Path,
+    cache: &str,
+    at: Vec3,
+    mu: f64,
+    (integrator, dt): (&str, f64),
+) -> Scene {
     build(
         &format!(
             r#"
@@ -92,7 +103,7 @@ positions = [[{}, {}, {}]]
 [[collider]]
 shape = {{ kind = "mesh", path = "plane.obj" }}
 response = {{ kind = "restitution", cr = 0.0, friction = {mu} }}
-motion = {{ cache = "plane.pc2", fps = 50.0 }}
+motion = {{ cache = "{cache}", fps = 50.0 }}
 "#,
             at.x, at.y, at.z
         ),
@@ -123,6 +134,46 @@ fn a_particle_on_a_rising_mesh_plane_rises_with_it() {
             p.v[0].y
         );
     }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// The same motion as an OBJ sequence (`plane_####.obj`, a file per sample holding the
+/// PC2's 32-bit positions, numbered from 7) moves the plane as its PC2 does: the particle
+/// resting on the sliding, rising plane follows the same trajectory, bit for bit, under
+/// block descent.
+#[test]
+fn an_obj_sequence_animates_a_collider_as_its_point_cache_does() {
+    let dir = folder("deforming-sequence");
+    let motion = |t: f64| Vec3::new(0.3 * t, 0.1 * t, 0.0);
+    moving_plane(&dir, motion);
+    let corners =
+        [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(x, z)| Vec3::new(x, 0.0, z));
+    for k in 0..=60 {
+        let m = motion(k as f64 / 50.0);
+        let at: Vec<Vec3> = corners
+            .iter()
+            .map(|c| (c + m).map(|v| f64::from(v as f32)))
+            .collect();
+        let file = dir.join(format!("plane_{:04}.obj", k + 7));
+        std::fs::write(file, obj(&at, &[vec![0, 3, 2, 1]])).unwrap();
+    }
+    let run = |cache: &str| {
+        let mut scene =
+            point_on_plane_from(&dir, cache, Vec3::new(0.1, 1e-3, 0.2), 0.5, ("vbd", 0.02));
+        (0..40)
+            .map(|_| {
+                scene.simulation.advance(1).unwrap();
+                scene.simulation.particles().x[0]
+            })
+            .collect::<Vec<_>>()
+    };
+    let (cached, sequence) = (run("plane.pc2"), run("plane_####.obj"));
+    assert_eq!(cached, sequence);
+    assert!(
+        (cached[39].x - 0.1 - 0.3 * 0.8).abs() < 0.01,
+        "{:?}",
+        cached[39]
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 

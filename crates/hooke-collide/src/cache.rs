@@ -1,6 +1,6 @@
 //! A vertex animation read from a PC2 point cache (Blender's Mesh Cache format, the one
-//! `hooke run --export NAME.pc2` writes): per sample, one position per vertex of a mesh, in
-//! the mesh file's vertex order.
+//! `hooke run --export NAME.pc2` writes), or from an OBJ sequence ([`crate::sequence`]):
+//! per sample, one position per vertex of a mesh, in the mesh file's vertex order.
 //!
 //! The format, little-endian: the 12 bytes `POINTCACHE2\0`, `i32` version 1, `i32` point
 //! count, `f32` start frame, `f32` sampling (frames per sample), `i32` sample count, then
@@ -44,12 +44,18 @@ impl VertexCache {
     /// not a positive number, a length other than the header's samples hold (a cache cut
     /// short or with bytes after it), and a coordinate that is not a finite number or lies
     /// beyond the world's extent (naming its sample and vertex).
+    ///
+    /// A path whose file name holds a run of `#` is an OBJ sequence instead
+    /// ([`VertexCache::read_sequence`]).
     pub fn read(
         path: &Path,
         vertices: usize,
         fps: f64,
         placement: &Placement,
     ) -> Result<Self, MeshError> {
+        if crate::sequence::is_sequence(path) {
+            return Self::read_sequence(path, vertices, fps, placement);
+        }
         let bytes = hooke_core::text::read_bytes(path).map_err(|source| MeshError::Io {
             path: path.to_path_buf(),
             source,
@@ -142,10 +148,12 @@ impl VertexCache {
             }
             samples.push(sample);
         }
-        Ok(Self {
-            samples,
-            interval: f64::from(sampling) / fps,
-        })
+        Ok(Self::from_samples(samples, f64::from(sampling) / fps))
+    }
+
+    /// The cache of `samples` (at least one, each placed), `interval` seconds apart.
+    pub(crate) fn from_samples(samples: Vec<Vec<Vec3>>, interval: f64) -> Self {
+        Self { samples, interval }
     }
 
     /// The number of samples.

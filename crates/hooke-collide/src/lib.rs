@@ -11,7 +11,7 @@
 //! | analytic cylinder tabletop | [`Cylinder`] | within the disc |
 //! | ball | [`Sphere`] | nearer the centre than the radius |
 //! | triangle mesh (OBJ) | [`TriMeshCollider`] | inside a closed part, or crossed in a step |
-//! | deforming mesh (OBJ + PC2) | [`DeformingMesh`] | as a mesh, on the cache's positions now |
+//! | deforming mesh (OBJ + PC2 or an OBJ sequence) | [`DeformingMesh`] | as a mesh, on the cache's positions now |
 //!
 //! Planes, the box, the cylinder and the ball are closed-form (the contract's formulas as written);
 //! meshes use parry3d-f64's BVH, point projection with pseudo-normals and ray casts, and are
@@ -36,6 +36,7 @@ mod deforming;
 mod obj;
 mod plane;
 mod polygons;
+mod sequence;
 mod shells;
 mod sphere;
 pub mod table;
@@ -48,6 +49,7 @@ pub use deforming::{DeformingMesh, MeshAnimation};
 pub use obj::{MeshError, MeshPart, Placement, load_obj, parse_obj};
 pub use plane::Plane;
 pub use polygons::{Polygon, PolygonMesh};
+pub use sequence::{is_sequence, sequence_files};
 pub use shells::{closedness_defect, signed_volume};
 pub use sphere::Sphere;
 pub use trimesh::TriMeshCollider;

@@ -112,7 +112,7 @@ pub enum MeshError {
         /// What is wrong.
         detail: String,
     },
-    /// A vertex cache (PC2) that cannot animate its mesh.
+    /// A vertex cache (PC2 or OBJ sequence) that cannot animate its mesh.
     #[error("{path}: {reason}")]
     Cache {
         /// The file.

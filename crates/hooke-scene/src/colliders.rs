@@ -319,10 +319,15 @@ impl SceneSpec {
             let cache = body.pin_motion.as_ref()?.cache.as_ref()?;
             Some((format!("body[{b}].pin_motion.cache"), base.join(cache)))
         });
-        bodies
-            .chain(colliders)
-            .chain(caches)
-            .chain(pin_caches)
-            .collect()
+        // An OBJ sequence is read from each of its files.
+        let caches = caches.chain(pin_caches).flat_map(|(key, path)| {
+            if !hooke_collide::is_sequence(&path) {
+                return vec![(key, path)];
+            }
+            hooke_collide::sequence_files(&path)
+                .map(|files| files.into_iter().map(|(_, f)| (key.clone(), f)).collect())
+                .unwrap_or_default()
+        });
+        bodies.chain(colliders).chain(caches).collect()
     }
 }
