@@ -24,7 +24,7 @@ from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty,
 
 from . import pc2
 from .run import Run, find_hooke
-from .scene import PRESETS, BakeError, from_hooke, write_scene
+from .scene import PRESETS, BakeError, from_hooke, ignored_settings, write_scene
 
 #: The modifier that plays a bake.
 MODIFIER = "Hooke"
@@ -307,6 +307,8 @@ class BakeOperator:
                     "Hooke > Kind)"
                 )
             self.job = Job(context, objs)
+            for note in ignored_settings(objs):
+                self.report({"WARNING"}, note)
         except BakeError as e:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}

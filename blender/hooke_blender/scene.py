@@ -256,6 +256,29 @@ def body_lines(obj, name, files, track, faces, pins, scale, fps):
     return lines
 
 
+def ignored_settings(objs):
+    """What a bake of ``objs`` together does not take from the objects after the first, as
+    messages: the integrator and substeps are the first one's, and a cloth's air drag
+    reaches a jelly baked with it."""
+    lead = objs[0].hooke
+    said = []
+    for obj in objs[1:]:
+        s = obj.hooke
+        if (s.integrator, s.substeps) != (lead.integrator, lead.substeps):
+            said.append(
+                f"Object '{obj.name}': its Integrator and Substeps ({s.integrator.lower()}, "
+                f"{s.substeps}) are not read; the bake takes '{objs[0].name}''s "
+                f"({lead.integrator.lower()}, {lead.substeps})"
+            )
+    if any(o.hooke.kind == "CLOTH" for o in objs):
+        said += [
+            f"Object '{o.name}': the cloth's air drag (mass_drag = 0.1) acts on this jelly too"
+            for o in objs
+            if o.hooke.kind == "JELLY"
+        ]
+    return said
+
+
 def write_scene(context, objs, folder, modifier):
     """Writes the scene of baking ``objs`` together into ``folder``: each as a body (the
     first sets the integrator and the substeps), every other collider of the scene, and

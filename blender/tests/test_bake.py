@@ -224,10 +224,11 @@ def edges_through(points, faces, other):
     return through
 
 
-def test_bake_all_simulates_two_cloths_together_each_with_its_own_cache(fresh):
+def test_bake_all_simulates_two_cloths_together_each_with_its_own_cache(fresh, capfd):
     """Two cloths dropped one onto the other, baked by one run: each plays its body's rows
     of `hooke run`'s trajectory, the upper comes to rest on the lower (baked alone, it would
-    fall through it to the floor), and neither passes through the other on any frame."""
+    fall through it to the floor), and neither passes through the other on any frame. The
+    lower one's own substeps are not read, and the bake says so."""
     scene = bpy.context.scene
     scene.frame_start, scene.frame_end = 1, 30
     scene.render.fps = 24
@@ -236,6 +237,7 @@ def test_bake_all_simulates_two_cloths_together_each_with_its_own_cache(fresh):
     for cloth in (lower, upper):
         cloth.hooke.kind = "CLOTH"
         cloth.hooke.friction = 0.5
+    lower.hooke.substeps = 3
     bpy.ops.mesh.primitive_cube_add(size=4.0, location=(0.0, 0.0, -2.0))
     floor = bpy.context.active_object
     floor.hooke.kind = "COLLIDER"
@@ -245,6 +247,9 @@ def test_bake_all_simulates_two_cloths_together_each_with_its_own_cache(fresh):
     # slash, cannot name a file, so its body is renamed.
     text = open(os.path.splitext(hooke_blender.cache_of(upper))[0] + "-scene/scene.toml").read()
     assert 'name = "body-0"' in text and 'name = "Lower"' in text, text
+    assert "every = 1\n" in text, text
+    said = capfd.readouterr()
+    assert "Object 'Lower': its Integrator and Substeps (vbd, 3) are not read" in said.out + said.err
     played_upper = assert_plays_hooke(upper, upper, 0)
     played_lower = assert_plays_hooke(lower, upper, len(upper.data.vertices))
     _, upper_faces = world_mesh(upper)
