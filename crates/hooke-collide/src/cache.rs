@@ -45,8 +45,9 @@ impl VertexCache {
     /// short or with bytes after it), and a coordinate that is not a finite number or lies
     /// beyond the world's extent (naming its sample and vertex).
     ///
-    /// A path whose file name holds a run of `#` is an OBJ sequence instead
-    /// ([`VertexCache::read_sequence`]).
+    /// A path whose file name holds a run of `#` is an OBJ sequence instead, a file per
+    /// sample ([`crate::sequence_files`]): refused, naming the file, when a frame is
+    /// missing, holds another vertex count or other faces than the first, or is not OBJ.
     pub fn read(
         path: &Path,
         vertices: usize,
@@ -54,7 +55,12 @@ impl VertexCache {
         placement: &Placement,
     ) -> Result<Self, MeshError> {
         if crate::sequence::is_sequence(path) {
-            return Self::read_sequence(path, vertices, fps, placement);
+            let frames = crate::sequence::read_frames(path, vertices)?;
+            let placed = frames
+                .iter()
+                .map(|f| f.iter().map(|p| placement.apply(p)).collect())
+                .collect();
+            return Ok(Self::from_samples(placed, 1.0 / fps));
         }
         let bytes = hooke_core::text::read_bytes(path).map_err(|source| MeshError::Io {
             path: path.to_path_buf(),
@@ -152,7 +158,7 @@ impl VertexCache {
     }
 
     /// The cache of `samples` (at least one, each placed), `interval` seconds apart.
-    pub(crate) fn from_samples(samples: Vec<Vec<Vec3>>, interval: f64) -> Self {
+    fn from_samples(samples: Vec<Vec<Vec3>>, interval: f64) -> Self {
         Self { samples, interval }
     }
 

@@ -2,12 +2,13 @@
 //! run of `#` stands for the frame number (`arm_####.obj` reads `arm_0001.obj`,
 //! `arm_0002.obj`, …), as Blender's OBJ exporter (with *Animation*), Houdini, Maya and
 //! Marvelous Designer write them. Each file's vertices, in its order, are one sample of a
-//! [`VertexCache`]: the first frame found is sample 0, and the frames must follow each other
-//! with no number missing and keep the first one's vertices and faces.
+//! vertex cache (`VertexCache::read` takes such a pattern): the first frame found is sample
+//! 0, and the frames must follow each other with no number missing and keep the first
+//! one's vertices and faces.
 
-use crate::cache::VertexCache;
-use crate::obj::{MeshError, Placement};
+use crate::obj::MeshError;
 use crate::polygons::PolygonMesh;
+use hooke_core::Vec3;
 use std::path::{Path, PathBuf};
 
 /// Frames a sequence may hold: past this the run would spend its memory on the collider.
@@ -123,54 +124,45 @@ pub fn sequence_files(pattern: &Path) -> Result<Vec<(u64, PathBuf)>, MeshError> 
     Ok(frames)
 }
 
-impl VertexCache {
-    /// Reads the OBJ sequence `pattern` (see the module's documentation) for a mesh of
-    /// `vertices` vertices, a frame every `1/fps` seconds, each point placed by `placement`.
-    ///
-    /// Refused as [`sequence_files`] refuses, and naming the file: one that is not a valid
-    /// OBJ (with its line), one whose vertex count is not the mesh's, one whose faces are
-    /// not the first frame's (the topology changes between frames).
-    pub fn read_sequence(
-        pattern: &Path,
-        vertices: usize,
-        fps: f64,
-        placement: &Placement,
-    ) -> Result<Self, MeshError> {
-        let files = sequence_files(pattern)?;
-        let mut first_faces: Option<(PathBuf, Vec<Vec<u32>>)> = None;
-        let mut samples = Vec::with_capacity(files.len());
-        for (_, path) in &files {
-            // Room for a mesh's faces (about twice its vertices), not for a file of another.
-            let mesh = PolygonMesh::load(path, 4 * vertices + 16)?;
-            if mesh.positions.len() != vertices {
+/// The samples of the OBJ sequence `pattern`: each file's vertices in its order, for a
+/// mesh of `vertices` vertices. Refused as [`sequence_files`] refuses, and naming the file:
+/// one that is not a valid OBJ (with its line), one whose vertex count is not the mesh's,
+/// one whose faces are not the first frame's (the topology changes between frames).
+pub(crate) fn read_frames(pattern: &Path, vertices: usize) -> Result<Vec<Vec<Vec3>>, MeshError> {
+    let files = sequence_files(pattern)?;
+    let mut first_faces: Option<(PathBuf, Vec<Vec<u32>>)> = None;
+    let mut samples = Vec::with_capacity(files.len());
+    for (_, path) in &files {
+        // Room for a mesh's faces (about twice its vertices), not for a file of another.
+        let mesh = PolygonMesh::load(path, 4 * vertices + 16)?;
+        if mesh.positions.len() != vertices {
+            return Err(refuse(
+                path,
+                format!(
+                    "it has {} vertices; the mesh has {vertices} (expected every frame of the \
+                     sequence to hold the mesh's vertices, in the file's order)",
+                    mesh.positions.len()
+                ),
+            ));
+        }
+        let faces: Vec<Vec<u32>> = mesh.faces.into_iter().map(|f| f.corners).collect();
+        match &first_faces {
+            None => first_faces = Some((path.clone(), faces)),
+            Some((first, want)) if *want != faces => {
                 return Err(refuse(
                     path,
                     format!(
-                        "it has {} vertices; the mesh has {vertices} (expected every frame of \
-                         the sequence to hold the mesh's vertices, in the file's order)",
-                        mesh.positions.len()
+                        "its faces are not those of {} (the first frame): the topology changes \
+                         between frames; expected the same faces in every frame",
+                        first.display()
                     ),
                 ));
             }
-            let faces: Vec<Vec<u32>> = mesh.faces.into_iter().map(|f| f.corners).collect();
-            match &first_faces {
-                None => first_faces = Some((path.clone(), faces)),
-                Some((first, want)) if *want != faces => {
-                    return Err(refuse(
-                        path,
-                        format!(
-                            "its faces are not those of {} (the first frame): the topology \
-                             changes between frames; expected the same faces in every frame",
-                            first.display()
-                        ),
-                    ));
-                }
-                Some(_) => {}
-            }
-            samples.push(mesh.positions.iter().map(|p| placement.apply(p)).collect());
+            Some(_) => {}
         }
-        Ok(Self::from_samples(samples, 1.0 / fps))
+        samples.push(mesh.positions);
     }
+    Ok(samples)
 }
 
 #[cfg(test)]
@@ -191,20 +183,16 @@ mod tests {
     }
 
     #[test]
-    fn frames_are_read_in_number_order_and_interpolated() {
+    fn frames_are_read_in_number_order() {
         let dir = folder("order");
         for (n, y) in [(9, 0.0), (10, 1.0), (11, 3.0)] {
             std::fs::write(dir.join(format!("tri_{n:04}.obj")), triangle(y)).unwrap();
         }
         std::fs::write(dir.join("tri_0012.mtl"), "").unwrap();
         std::fs::write(dir.join("tri_00013.obj"), triangle(9.0)).unwrap();
-        let cache =
-            VertexCache::read_sequence(&dir.join("tri_####.obj"), 3, 10.0, &Placement::default())
-                .unwrap();
-        assert_eq!(cache.len(), 3);
-        let mut x = Vec::new();
-        cache.at(0.15, &mut x);
-        assert!((x[2].y - 2.0).abs() < 1e-12, "{x:?}");
+        let samples = read_frames(&dir.join("tri_####.obj"), 3).unwrap();
+        let heights: Vec<f64> = samples.iter().map(|s| s[2].y).collect();
+        assert_eq!(heights, [0.0, 1.0, 3.0]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -212,7 +200,7 @@ mod tests {
     fn a_gap_a_count_or_faces_that_change_are_refused_by_name() {
         let dir = folder("bad");
         let pattern = dir.join("tri_##.obj");
-        let read = || VertexCache::read_sequence(&pattern, 3, 24.0, &Placement::default());
+        let read = || read_frames(&pattern, 3);
         let said = read().unwrap_err().to_string();
         assert!(said.contains("no file matches it"), "{said}");
         std::fs::write(dir.join("tri_01.obj"), triangle(0.0)).unwrap();
