@@ -227,29 +227,7 @@ fn a_point_cache_matches_the_trajectory_and_its_mesh_loads_with_tobj() {
 }
 
 /// Two cloths, one dropped onto the other, in one scene: each a 6 × 6 grid.
-const TWO_CLOTHS: &str = r#"
-name = "two"
-[simulation]
-integrator = "symplectic"
-dt = 0.0005
-steps = 800
-every = 80
-[[body]]
-name = "under"
-mass = 0.002
-origin = [0.0, 0.1, 0.0]
-shape = { kind = "grid", size = [6, 6], spacing = 0.05 }
-springs = { structural = { ks = 200.0, kd = 0.05 }, shear = { ks = 100.0, kd = 0.05 }, bend = { ks = 10.0, kd = 0.01 } }
-[[body]]
-name = "over"
-mass = 0.002
-origin = [0.02, 0.2, 0.02]
-shape = { kind = "grid", size = [6, 6], spacing = 0.05 }
-springs = { structural = { ks = 200.0, kd = 0.05 }, shear = { ks = 100.0, kd = 0.05 }, bend = { ks = 10.0, kd = 0.01 } }
-[[collider]]
-shape = { kind = "ground", height = 0.0 }
-response = { kind = "restitution", cr = 0.0, friction = 0.5 }
-"#;
+const TWO_CLOTHS: &str = include_str!("../../../tests/fixtures/two-cloths.toml");
 
 /// `(points, samples)` of a point cache's header.
 fn pc2_header(path: &Path) -> (i32, i32) {
