@@ -55,7 +55,7 @@ fn frame_number(name: &str, (prefix, suffix, width): (&str, &str, usize)) -> Opt
 
 /// The files of the sequence `pattern` in frame order, with their numbers. Refused, naming
 /// the pattern: a second run of `#`, a folder that cannot be read, no file that matches,
-/// more than [`MOST_FRAMES`], and a number missing between the first and the last (naming
+/// more than 100 000 frames, and a number missing between the first and the last (naming
 /// the file that is not there).
 pub fn sequence_files(pattern: &Path) -> Result<Vec<(u64, PathBuf)>, MeshError> {
     let Some((prefix, suffix, width)) = split(pattern) else {
