@@ -165,11 +165,16 @@ def bodies_of(context):
     """Every cloth and jelly of the scene, the active object first when it is one (it sets
     the integrator and substeps of a bake of them all), the others by name."""
     active = context.active_object
-    found = sorted(
+    return sorted(
         (o for o in context.scene.objects if o.hooke.kind in ("CLOTH", "JELLY")),
         key=lambda o: (o is not active, o.name),
     )
-    return found
+
+
+def title_of(objs):
+    """The objects of a bake, as messages name them: ``Object 'Cloth'``."""
+    names = ", ".join(f"'{o.name}'" for o in objs)
+    return f"Object {names}" if len(objs) == 1 else f"Objects {names}"
 
 
 class Job:
@@ -178,8 +183,7 @@ class Job:
 
     def __init__(self, context, objs):
         self.objs = objs
-        self.obj = objs[0]
-        folder = folder_of(self.obj)
+        folder = folder_of(objs[0])
         self.finals = [cache_of(o) for o in objs]
         for final in self.finals:
             os.makedirs(os.path.dirname(final), exist_ok=True)
@@ -191,7 +195,12 @@ class Job:
                 context, objs, self.work, MODIFIER
             )
             # One body: its cache; several: a folder of one per body, named as the bodies.
-            out = os.path.join(self.work, "out.pc2" if len(objs) == 1 else "out" + os.sep)
+            if len(objs) == 1:
+                out = os.path.join(self.work, "out.pc2")
+                self.outs = [out]
+            else:
+                out = os.path.join(self.work, "out") + os.sep
+                self.outs = [os.path.join(out, name + ".pc2") for name, _ in self.bodies]
             self.run = Run(program, self.scene, out)
         except BaseException:
             shutil.rmtree(self.work, ignore_errors=True)
@@ -199,9 +208,8 @@ class Job:
 
     @property
     def title(self):
-        """The objects baked, as messages name them: ``Object 'Cloth'``."""
-        names = ", ".join(f"'{o.name}'" for o in self.objs)
-        return f"Object {names}" if len(self.objs) == 1 else f"Objects {names}"
+        """The objects baked, as messages name them."""
+        return title_of(self.objs)
 
     def finish(self, context):
         """Puts the finished run's caches in place (each in its object's own coordinates)
@@ -216,11 +224,9 @@ class Job:
             if self.run.poll() != 0:
                 raise BakeError(f"{self.title}: hooke stopped: {self.run.failure()}")
             scale = context.scene.unit_settings.scale_length or 1.0
-            for k, ((name, matrices), final) in enumerate(zip(self.bodies, self.finals)):
-                if len(self.objs) == 1:
-                    out = os.path.join(self.work, "out.pc2")
-                else:
-                    out = os.path.join(self.work, "out", name + ".pc2")
+            for k, ((_, matrices), out, final) in enumerate(
+                zip(self.bodies, self.outs, self.finals)
+            ):
                 samples = pc2.read(out)
                 local = [
                     [tuple(m.inverted() @ from_hooke(p, scale)) for p in sample]
@@ -313,8 +319,7 @@ class BakeOperator:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
         except KeyboardInterrupt:
-            names = ", ".join(f"'{o.name}'" for o in objs)
-            self.report({"WARNING"}, f"Object {names}: bake cancelled; the earlier cache is kept")
+            self.report({"WARNING"}, f"{title_of(objs)}: bake cancelled; the earlier cache is kept")
             return {"CANCELLED"}
         if bpy.app.background or context.window is None:
             return self.wait(context)
