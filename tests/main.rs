@@ -28,6 +28,7 @@ mod newton;
 mod oscillator;
 mod roundtrip;
 mod scenes;
+mod slivers;
 mod starts;
 mod statics;
 mod worlds;

@@ -2,6 +2,7 @@
 //! hashed grids, and particle–triangle and edge–edge pairs gathered in fixed chunks, so
 //! that the lists come out in the same order on any thread count.
 
+use super::exclusion::Exclusion;
 use super::grid::Grid;
 use super::proximity::{point_triangle, segment_segment};
 use crate::model::Model;
@@ -11,6 +12,8 @@ use rayon::prelude::*;
 /// A model's contact primitives, for gathering candidate pairs.
 pub(super) struct Prims<'a> {
     pub(super) model: &'a Model,
+    /// The pairs of one surface that its own structure holds apart: never candidates.
+    pub(super) skip: &'a Exclusion,
     pub(super) owners: &'a [u32],
     pub(super) points: &'a [u32],
     pub(super) tris: &'a [[u32; 3]],
@@ -50,6 +53,7 @@ impl Prims<'_> {
                     let tri = tris[t as usize];
                     if !tri.contains(&p)
                         && inside(&xp, &tri_box[t as usize])
+                        && !self.skip.skips_triangle(p, t)
                         && pair(model, owners, p, tri[0]).is_some()
                     {
                         let [a, b, c] = tri.map(|i| x[i as usize]);
@@ -79,6 +83,7 @@ impl Prims<'_> {
                         && !ef.contains(&ee[0])
                         && !ef.contains(&ee[1])
                         && overlap(&edge_box[e as usize], &edge_box[f as usize])
+                        && !self.skip.skips_edges(e, f)
                         && pair(model, owners, ee[0], ef[0]).is_some()
                     {
                         let [a, b] = ee.map(|i| x[i as usize]);

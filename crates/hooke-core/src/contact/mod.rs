@@ -10,7 +10,8 @@
 //!    stick); see `respond::respond_all`.
 //! 2. **Proximities.** Collider features (mesh edges at an angle, the cylinder's rims)
 //!    nearer than `h` to a surface triangle, and particle–triangle and edge–edge pairs of
-//!    surfaces nearer than `h` (self-collision within a body, and between bodies), each give
+//!    surfaces nearer than `h` (self-collision within a body, less the pairs its own
+//!    structure holds apart, `exclusion.rs`; and between bodies), each give
 //!    a stencil: weights `w_k` on up to four particles such that `Σ w_k x_k` is the gap
 //!    vector. Sweeps of Gauss–Seidel projections in a fixed order push each gap open to
 //!    `h` along its normal, sharing the correction by inverse mass (`Δx_k ∝ w_k / m_k`).
@@ -33,6 +34,7 @@
 //! results are the same bits on any thread count.
 
 mod budgets;
+pub(crate) mod exclusion;
 mod gather;
 pub(crate) mod grid;
 pub mod proximity;
@@ -44,10 +46,9 @@ use crate::collider::response::coulomb_cut;
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
 use budgets::{Budgets, next_budget};
+use exclusion::{Exclusion, Surfaces};
 use gather::{Bins, Prims, append, overlap, pair, par_fill};
-use proximity::{
-    ball_triangle, circle_triangle, point_triangle, segment_segment, segment_triangle,
-};
+use proximity::{feature_gap, point_triangle, segment_segment};
 use respond::{FaceSkip, respond_all, respond_one};
 use std::time::Instant;
 use stencil::{Rule, Stencil};
@@ -99,6 +100,10 @@ pub(crate) struct ContactState {
     points: Vec<u32>,
     tris: Vec<[u32; 3]>,
     edges: Vec<[u32; 2]>,
+    /// The pairs the surfaces' own structure holds apart, never candidates (`exclusion.rs`).
+    exclusion: Exclusion,
+    /// Whether any surface pair (self or between bodies) can touch.
+    self_pairs: bool,
     /// Largest thickness, and how far beyond it candidates reach.
     h_max: f64,
     skin: f64,
@@ -168,9 +173,27 @@ impl ContactState {
             self.edges.extend(s.edges());
             self.h_max = self.h_max.max(s.thickness);
         }
+        self.self_pairs = active.len() > 1 || active.iter().any(|(_, s)| s.self_collision);
         // Half a skin of travel between builds: a cloth falling a few metres a second
         // rebuilds every few steps, a resting one never.
         self.skin = 2.0 * self.h_max;
+    }
+
+    /// Lists the pairs the surfaces' own structure holds apart, from the rest positions
+    /// `rest` (the first step's start): near along the edges within twice the largest
+    /// thickness, or one edge apart within it, which this phase would otherwise push apart
+    /// at rest or at the first compression of a fine mesh (block descent's bounds reach
+    /// further: [`Model::self_contact_skip`]); pairs with a pinned particle are kept.
+    fn exclude(&mut self, rest: &[Vec3], p: &Particles) {
+        let surface_of = &self.surface_of;
+        let surfaces = Surfaces {
+            triangles: &self.tris,
+            edges: &self.edges,
+            on_surface: &|v| surface_of[v as usize] != NONE,
+            self_pairs: self.self_pairs,
+        };
+        let (radius, pinned) = (2.0 * self.h_max, |i| p.is_pinned(i as usize));
+        self.exclusion = Exclusion::new(&surfaces, rest, (radius, self.h_max), &pinned);
     }
 
     /// The largest displacement of a surface particle from `x_ref`, measured from `shift`
@@ -244,6 +267,7 @@ impl ContactState {
         );
         let prims = Prims {
             model,
+            skip: &self.exclusion,
             owners: &self.surface_of,
             points: &self.points,
             tris: &self.tris,
@@ -452,29 +476,6 @@ impl ContactState {
     }
 }
 
-/// The closest points of a collider feature and triangle `t` at `x`: the feature's point
-/// and the triangle's barycentric weights; `None` when a cheap bound shows they are farther
-/// apart than `within`.
-fn feature_gap(
-    feature: &Feature,
-    t: &[u32; 3],
-    x: &[Vec3],
-    within: f64,
-) -> Option<(Vec3, [f64; 3])> {
-    let (a, b, c) = (&x[t[0] as usize], &x[t[1] as usize], &x[t[2] as usize]);
-    let (anchor, w) = match feature {
-        Feature::Segment([p, q]) => {
-            let (s, w) = segment_triangle(p, q, a, b, c);
-            (p + (q - p) * s, w)
-        }
-        Feature::Circle(circle) if circle.distance_bound(a, b, c) >= within => return None,
-        Feature::Circle(circle) => circle_triangle(circle, a, b, c),
-        Feature::Ball { center, radius } => ball_triangle(center, *radius, a, b, c),
-    };
-    let gap = a * w[0] + b * w[1] + c * w[2] - anchor;
-    (gap.norm_squared() < within * within).then_some((anchor, w))
-}
-
 /// Runs the contact phase after an integrator step: `x0` are the step's start positions.
 /// Returns whether it may have moved any particle.
 pub(crate) fn phase(
@@ -486,6 +487,9 @@ pub(crate) fn phase(
     let started = Instant::now();
     if !state.ready {
         state.prepare(model, p.len());
+        if !state.points.is_empty() {
+            state.exclude(x0, p);
+        }
     }
     let held = &mut state.held;
     if state.face.len() != p.len() {

@@ -6,7 +6,7 @@
 //! The point–triangle and segment–segment routines follow Ericson, *Real-Time Collision
 //! Detection* (2005), §5.1.5 and §5.1.9.
 
-use crate::collider::Circle;
+use crate::collider::{Circle, Feature};
 use crate::particles::Vec3;
 
 /// Squared lengths below this are treated as zero (degenerate segments and triangles).
@@ -365,6 +365,41 @@ pub(crate) fn ball_triangle(
         .or_else(|| (b - a).cross(&(c - a)).try_normalize(0.0))
         .unwrap_or_else(Vec3::y);
     (center + out * radius, w)
+}
+
+/// The closest points of a collider feature and triangle `t` at `x`: the feature's point
+/// and the triangle's barycentric weights; `None` when a cheap bound shows they are farther
+/// apart than `within`.
+pub(super) fn feature_gap(
+    feature: &Feature,
+    t: &[u32; 3],
+    x: &[Vec3],
+    within: f64,
+) -> Option<(Vec3, [f64; 3])> {
+    let (a, b, c) = (&x[t[0] as usize], &x[t[1] as usize], &x[t[2] as usize]);
+    let (anchor, w) = match feature {
+        Feature::Segment([p, q]) => {
+            let (s, w) = segment_triangle(p, q, a, b, c);
+            (p + (q - p) * s, w)
+        }
+        Feature::Circle(circle) if circle.distance_bound(a, b, c) >= within => return None,
+        Feature::Circle(circle) => circle_triangle(circle, a, b, c),
+        Feature::Ball { center, radius } => ball_triangle(center, *radius, a, b, c),
+    };
+    let gap = a * w[0] + b * w[1] + c * w[2] - anchor;
+    (gap.norm_squared() < within * within).then_some((anchor, w))
+}
+
+/// The distance from `p` to triangle `abc`.
+pub(crate) fn point_triangle_distance(p: &Vec3, [a, b, c]: [&Vec3; 3]) -> f64 {
+    let w = point_triangle(p, a, b, c);
+    (p - (a * w[0] + b * w[1] + c * w[2])).norm()
+}
+
+/// The distance between segments `p1q1` and `p2q2`.
+pub(crate) fn segment_distance([p1, q1, p2, q2]: [&Vec3; 4]) -> f64 {
+    let (s, t) = segment_segment(p1, q1, p2, q2);
+    ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm()
 }
 
 #[cfg(test)]

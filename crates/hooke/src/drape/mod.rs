@@ -260,37 +260,6 @@ response = {{ kind = "restitution", cr = 0.0, friction = {friction:e} }}
                 area * 1e4
             )));
         }
-        // Self-contact keeps the cloth `thickness` from itself, which two ends of an edge
-        // shorter than twice that would already violate (the scene would refuse the body's
-        // `thickness`, a key the meter sets, not the user).
-        let shortest = mesh
-            .faces
-            .iter()
-            .flat_map(|f| {
-                let c = &f.corners;
-                (0..c.len()).map(move |k| (c[k], c[(k + 1) % c.len()]))
-            })
-            .filter_map(|(a, b)| {
-                let (p, q) = (
-                    mesh.positions.get(a as usize)?,
-                    mesh.positions.get(b as usize)?,
-                );
-                Some((p - q).norm())
-            })
-            .filter(|d| *d > 0.0)
-            .fold(f64::INFINITY, f64::min);
-        if shortest <= 2.0 * self.thickness {
-            return Err(crate::Error::input(format!(
-                "{}: its shortest edge is {:.2} mm; the meter keeps the cloth {} mm from \
-                 itself, which needs every edge at least {} mm long: give --mesh a disc \
-                 remeshed with no edge under {} mm",
-                path.display(),
-                shortest * 1e3,
-                hooke_core::Num(self.thickness * 1e3),
-                hooke_core::Num(2.0 * self.thickness * 1e3),
-                hooke_core::Num(2.0 * self.thickness * 1e3),
-            )));
-        }
         Ok(())
     }
 

@@ -18,9 +18,10 @@
 //! positions then) differs, and no thread count changes it.
 
 use super::cells::{bin, bounds_of, boxes_within, by_cell, concatenate, within};
-use super::exclusion::Exclusion;
-use super::topology::{Topology, point_triangle_distance, segment_distance};
+use super::topology::Topology;
+use crate::contact::exclusion::Exclusion;
 use crate::contact::grid::{Cell, Grid};
+use crate::contact::proximity::{point_triangle_distance, segment_distance};
 use crate::particles::Vec3;
 use rayon::prelude::*;
 

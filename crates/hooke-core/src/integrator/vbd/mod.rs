@@ -24,7 +24,6 @@
 mod candidates;
 mod cells;
 pub(in crate::integrator) mod detect;
-mod exclusion;
 pub(in crate::integrator) mod graph;
 mod lanes;
 pub(in crate::integrator) mod local;

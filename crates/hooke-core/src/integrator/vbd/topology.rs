@@ -3,7 +3,7 @@
 //! and which triangle owns each shared edge and corner (so a pair is counted once).
 
 use crate::collider::response::Response;
-use crate::contact::proximity::{point_triangle, segment_segment};
+use crate::contact::exclusion::{Exclusion, Surfaces};
 use crate::model::Model;
 use crate::particles::Vec3;
 
@@ -95,14 +95,24 @@ impl Topology {
     }
 }
 
-/// The distance from `p` to triangle `abc`.
-pub(in crate::integrator) fn point_triangle_distance(p: &Vec3, [a, b, c]: [&Vec3; 3]) -> f64 {
-    let w = point_triangle(p, a, b, c);
-    (p - (a * w[0] + b * w[1] + c * w[2])).norm()
-}
-
-/// The distance between segments `p1q1` and `p2q2`.
-pub(in crate::integrator) fn segment_distance([p1, q1, p2, q2]: [&Vec3; 4]) -> f64 {
-    let (s, t) = segment_segment(p1, q1, p2, q2);
-    ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm()
+impl Topology {
+    /// The pairs of these surfaces that their own structure holds apart, from the rest
+    /// positions `rest` with radius `radius` and, for pairs one edge apart, `near`
+    /// (`crate::contact::exclusion`).
+    pub(in crate::integrator) fn exclusion(
+        &self,
+        rest: &[Vec3],
+        (radius, near): (f64, f64),
+        pinned: &(dyn Fn(u32) -> bool + Sync),
+    ) -> Exclusion {
+        let triangles: Vec<[u32; 3]> = self.triangles.iter().map(|t| t.0).collect();
+        let edges: Vec<[u32; 2]> = self.edges.iter().map(|e| e.0).collect();
+        let surfaces = Surfaces {
+            triangles: &triangles,
+            edges: &edges,
+            on_surface: &|v| self.surface[v as usize] != u16::MAX,
+            self_pairs: self.self_pairs,
+        };
+        Exclusion::new(&surfaces, rest, (radius, near), pinned)
+    }
 }

@@ -16,8 +16,8 @@
 //! Distances are searched only up to a reach (`R_s`, `R_c`); a pair farther than the reach
 //! bounds by the reach, which is enough for the same argument. The bound holds whatever the
 //! step size: the integrator can fail to converge, never cross. The pairs of one surface
-//! that its own springs hold apart (`exclusion.rs`: within the reach of each other at rest,
-//! and along the surface) are not searched and bound nothing: the argument does not cover
+//! that its own springs hold apart (`contact/exclusion.rs`: within the reach of each other at
+//! rest, and along the surface or neighbours) are not searched and bound nothing: the argument does not cover
 //! them, and a crease that brings such a pair within a thickness can cross.
 
 mod colliders;
@@ -25,12 +25,12 @@ mod colliders;
 pub(in crate::integrator) use colliders::collider_law;
 
 use super::candidates::{Candidates, SKIN, search};
-use super::exclusion::Exclusion;
 use super::graph::Graph;
 use super::pairs::{Pair, Sides, stencil_distance};
 use super::planes::{HalfSpaces, Touches};
 use super::topology::Topology;
 use crate::collider::response::Response;
+use crate::contact::exclusion::Exclusion;
 use crate::contact::grid::Grid;
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
@@ -114,7 +114,7 @@ pub(in crate::integrator) struct Detection {
     /// Positions at the first step: pairs nearer than their gap there are neighbours in the
     /// body's own rest shape, not contacts.
     rest: Vec<Vec3>,
-    /// The pairs the surfaces' own structure holds apart, never measured (`exclusion.rs`).
+    /// The pairs the surfaces' own structure holds apart, never measured (`contact/exclusion.rs`).
     exclusion: Exclusion,
     /// Per particle: the collider surfaces it may reach before the next detection, each as
     /// its tangent plane at the detection.
@@ -250,23 +250,21 @@ impl Detection {
         dt: f64,
     ) {
         let n = x.len();
-        if self.topology.built_for != n || self.rest.len() != n {
-            self.topology = Topology::new(model, n);
-            self.rest = x.to_vec();
-            self.exclusion = Exclusion::new(
-                &self.topology,
-                &self.rest,
-                model.self_contact_skip(),
-                &|i| p.is_pinned(i as usize),
-            );
-        }
-        self.scale.clear();
-        self.scale
-            .extend((0..n).map(|i| p.mass[i] / (dt * dt) + graph.stiffness[i]));
         let h_max = model
             .active_surfaces()
             .map(|(_, s)| s.thickness)
             .fold(0.0, f64::max);
+        if self.topology.built_for != n || self.rest.len() != n {
+            self.topology = Topology::new(model, n);
+            self.rest = x.to_vec();
+            // Pairs one edge apart only where they start within the thickness: a sliver's.
+            let reach = (model.self_contact_skip(), h_max);
+            let pinned = |i: u32| p.is_pinned(i as usize);
+            self.exclusion = self.topology.exclusion(&self.rest, reach, &pinned);
+        }
+        self.scale.clear();
+        self.scale
+            .extend((0..n).map(|i| p.mass[i] / (dt * dt) + graph.stiffness[i]));
         self.h_max = h_max;
         let points = self.topology.surface.contains(&u16::MAX);
         let h_collider = if points {
