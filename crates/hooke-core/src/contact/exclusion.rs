@@ -246,9 +246,10 @@ impl Exclusion {
                     paths.search(&adj, &[v], path);
                     let p = &rest[v as usize];
                     let mut out = Vec::new();
-                    let along = paths.reached.clone();
+                    // Taken while `first_sight` marks the search, and given back for the next.
+                    let along = std::mem::take(&mut paths.reached);
                     let next = adj.neighbours[v as usize].iter().map(|&(w, _)| (w, near));
-                    for (w, within) in along.into_iter().map(|w| (w, radius)).chain(next) {
+                    for (w, within) in along.iter().map(|&w| (w, radius)).chain(next) {
                         for &t in &adj.triangles[w as usize] {
                             let tri = surfaces.triangles[t as usize];
                             if paths.first_sight(t)
@@ -261,6 +262,7 @@ impl Exclusion {
                             }
                         }
                     }
+                    paths.reached = along;
                     out.sort_unstable();
                     out
                 },
@@ -278,11 +280,11 @@ impl Exclusion {
                     }
                     paths.search(&adj, &[a, b], path);
                     let mut out = Vec::new();
-                    let along = paths.reached.clone();
+                    let along = std::mem::take(&mut paths.reached);
                     let next = [a, b]
                         .into_iter()
                         .flat_map(|k| adj.neighbours[k as usize].iter().map(|&(w, _)| (w, near)));
-                    for (w, within) in along.into_iter().map(|w| (w, radius)).chain(next) {
+                    for (w, within) in along.iter().map(|&w| (w, radius)).chain(next) {
                         for &f in &adj.edges[w as usize] {
                             let [c, d] = surfaces.edges[f as usize];
                             let ends = [a, b, c, d].map(|i| &rest[i as usize]);
@@ -297,6 +299,7 @@ impl Exclusion {
                             }
                         }
                     }
+                    paths.reached = along;
                     out.sort_unstable();
                     out
                 },

@@ -102,8 +102,6 @@ pub(crate) struct ContactState {
     edges: Vec<[u32; 2]>,
     /// The pairs the surfaces' own structure holds apart, never candidates (`exclusion.rs`).
     exclusion: Exclusion,
-    /// Whether any surface pair (self or between bodies) can touch.
-    self_pairs: bool,
     /// Largest thickness, and how far beyond it candidates reach.
     h_max: f64,
     skin: f64,
@@ -173,7 +171,6 @@ impl ContactState {
             self.edges.extend(s.edges());
             self.h_max = self.h_max.max(s.thickness);
         }
-        self.self_pairs = active.len() > 1 || active.iter().any(|(_, s)| s.self_collision);
         // Half a skin of travel between builds: a cloth falling a few metres a second
         // rebuilds every few steps, a resting one never.
         self.skin = 2.0 * self.h_max;
@@ -184,13 +181,13 @@ impl ContactState {
     /// thickness, or one edge apart within it, which this phase would otherwise push apart
     /// at rest or at the first compression of a fine mesh (block descent's bounds reach
     /// further: [`Model::self_contact_skip`]); pairs with a pinned particle are kept.
-    fn exclude(&mut self, rest: &[Vec3], p: &Particles) {
+    fn exclude(&mut self, model: &Model, rest: &[Vec3], p: &Particles) {
         let surface_of = &self.surface_of;
         let surfaces = Surfaces {
             triangles: &self.tris,
             edges: &self.edges,
             on_surface: &|v| surface_of[v as usize] != NONE,
-            self_pairs: self.self_pairs,
+            self_pairs: model.surfaces_touch(),
         };
         let (radius, pinned) = (2.0 * self.h_max, |i| p.is_pinned(i as usize));
         self.exclusion = Exclusion::new(&surfaces, rest, (radius, self.h_max), &pinned);
@@ -488,7 +485,7 @@ pub(crate) fn phase(
     if !state.ready {
         state.prepare(model, p.len());
         if !state.points.is_empty() {
-            state.exclude(x0, p);
+            state.exclude(model, x0, p);
         }
     }
     let held = &mut state.held;

@@ -143,6 +143,17 @@ impl Model {
             .filter(|(_, s)| s.is_active())
     }
 
+    /// Whether any pair of active surfaces can touch: two of them, or one that collides
+    /// with itself.
+    pub(crate) fn surfaces_touch(&self) -> bool {
+        let mut active = self.active_surfaces();
+        match (active.next(), active.next()) {
+            (Some(_), Some(_)) => true,
+            (Some((_, s)), None) => s.self_collision,
+            _ => false,
+        }
+    }
+
     /// The contact thickness the large steps (`vbd`, `newton`) keep between a particle
     /// outside every active surface (a chain's, a lattice's, a point's) and a restitution or
     /// stick collider, metres: 1 mm, or a quarter of the model's shortest

@@ -70,7 +70,7 @@ impl Topology {
                 .extend(s.triangles.iter().map(|&tri| (tri, k as u16)));
             t.edges.extend(s.edges().into_iter().map(|e| (e, k as u16)));
         }
-        t.self_pairs = active.len() > 1 || active.iter().any(|(_, s)| s.self_collision);
+        t.self_pairs = model.surfaces_touch();
         let mut edges = std::collections::HashSet::new();
         let mut corners = vec![false; n];
         t.owns = t
