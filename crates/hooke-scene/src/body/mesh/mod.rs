@@ -47,7 +47,7 @@ pub(crate) fn cloth(
     (path, scale, weld): (&str, Vec3, Option<f64>),
 ) -> Result<BuiltBody, BuildError> {
     let (mesh, full) = read(path, base, key)?;
-    let sheet = sheet::sheet(mesh, &full, key, scale, weld)?;
+    let mut sheet = sheet::sheet(mesh, &full, key, scale, weld)?;
     let pins = mesh_pins(body, key, &sheet)?;
     let (masses, springs) = match &body.material {
         Some(m) => {
@@ -55,7 +55,7 @@ pub(crate) fn cloth(
             let material = m.resolve(&format!("{key}.material"))?;
             (
                 fabric_masses(&sheet, &material),
-                fabric_springs(&sheet, &material, offset, &pins),
+                fabric_springs(&mut sheet, &material, offset, &pins, &full),
             )
         }
         None => {
@@ -202,9 +202,16 @@ fn membrane_springs(sheet: &Sheet, m: &Material) -> BTreeMap<(u32, u32), (f64, f
     out
 }
 
-/// A fabric's springs on a mesh: the membrane (damped `damping · ks`) and Bergou's bending
-/// as zero-rest-length springs (undamped), as docs/physics.md §1.1 states.
-fn fabric_springs(sheet: &Sheet, m: &Material, offset: usize, pins: &[usize]) -> Vec<Spring> {
+/// A fabric's springs on a mesh: the membrane (damped `damping · ks`) and the bending as
+/// zero-rest-length springs (undamped), as docs/physics.md §1.1 states. A mesh with slivers
+/// is told that its bending is fitted to the points.
+fn fabric_springs(
+    sheet: &mut Sheet,
+    m: &Material,
+    offset: usize,
+    pins: &[usize],
+    path: &Path,
+) -> Vec<Spring> {
     let mut out: Vec<Spring> = membrane_springs(sheet, m)
         .into_iter()
         .filter(|(_, (k, ..))| *k > 0.0)
@@ -216,15 +223,22 @@ fn fabric_springs(sheet: &Sheet, m: &Material, offset: usize, pins: &[usize]) ->
         for &p in pins.iter().filter(|&&p| p < n) {
             held[p] = true;
         }
+        let (bend, steepest) = bending::springs(&sheet.local, &sheet.polygons, m.bending, &|p| {
+            held[p as usize]
+        });
+        if let Some(steepest) = steepest {
+            sheet.warnings.push(format!(
+                "{}: slivers (a triangle {} times as long as it is high, over {}): its \
+                 bending is fitted to each vertex's neighbours rather than taken on hinges \
+                 (docs/physics.md §1.1, \"Bending on slivers\")",
+                path.display(),
+                steepest.round(),
+                bending::SLIVER
+            ));
+        }
         out.extend(
-            bending::hinge_springs(
-                &sheet.local,
-                &bending::pieces(&sheet.polygons),
-                m.bending,
-                &|p| held[p as usize],
-            )
-            .into_iter()
-            .map(|(pair, k)| spring(offset, pair, 0.0, k, 0.0, SpringKind::Bend)),
+            bend.into_iter()
+                .map(|(pair, k)| spring(offset, pair, 0.0, k, 0.0, SpringKind::Bend)),
         );
     }
     out

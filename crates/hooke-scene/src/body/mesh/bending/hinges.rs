@@ -1,5 +1,5 @@
 //! Bending on triangles: Bergou et al. 2006's quadratic model, written exactly as
-//! zero-rest-length springs (docs/physics.md §1.1, "Meshes").
+//! zero-rest-length springs (docs/physics.md §1.1, "Meshes"), on meshes without slivers.
 //!
 //! Across an interior edge `x0 x1` with opposite corners `x2` and `x3`, let `K` weigh the
 //! four corners so that `Σ K_i x_i` is `|e|` times the sum of the two triangles' in-plane unit
@@ -13,6 +13,7 @@
 //! `Σ K_i = 0`, `|Σ K_i x_i|² = −Σ_{i<j} K_i K_j |x_i − x_j|²`: six springs of rest length
 //! zero and stiffness `−w K_i K_j`, with `w = B / (A₁ + A₂)`.
 
+use crate::body::mesh::bending::PairSprings;
 use crate::body::mesh::sheet::canonical;
 use hooke_core::Vec3;
 use std::collections::{BTreeMap, HashMap};
@@ -74,7 +75,7 @@ pub(crate) fn pieces(polygons: &[Vec<u32>]) -> Vec<Piece> {
 
 /// The zero-rest-length springs of the bending energy of `triangles` (corner indices into
 /// `x`, the rest shape) for a rigidity `bending` (N·m), summed per pair of particles, in
-/// ascending order of the pair. A hinge whose edge and one side are `pinned` and whose
+/// ascending order of the pair, and the largest `|e|/h` of any hinge. A hinge whose edge and one side are `pinned` and whose
 /// other side is free is a clamped edge: of the material it stands for, only the free
 /// triangle's side bends, so its weight is doubled (as a grid's clamped line element is,
 /// which makes a cantilever's error second order in the spacing).
@@ -83,7 +84,8 @@ pub(crate) fn hinge_springs(
     triangles: &[Piece],
     bending: f64,
     pinned: &dyn Fn(u32) -> bool,
-) -> Vec<((u32, u32), f64)> {
+) -> (PairSprings, f64) {
+    let mut steepest = 0.0f64;
     let mut sides: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
     for (t, piece) in triangles.iter().enumerate() {
         let tri = piece.corners;
@@ -135,6 +137,7 @@ pub(crate) fn hinge_springs(
             let along = (q - p[0]).dot(&e) / len2;
             let height = 2.0 * area(q) / len2.sqrt();
             let km = len2.sqrt() / height;
+            steepest = steepest.max(km);
             k[m] += km;
             k[0] -= km * (1.0 - along);
             k[1] -= km * along;
@@ -148,7 +151,8 @@ pub(crate) fn hinge_springs(
             }
         }
     }
-    out.into_iter().filter(|(_, k)| *k != 0.0).collect()
+    let springs = out.into_iter().filter(|(_, k)| *k != 0.0).collect();
+    (springs, steepest)
 }
 
 #[cfg(test)]
@@ -226,7 +230,7 @@ mod tests {
                 weight: 1.0,
             })
             .collect();
-        let springs = hinge_springs(&flat, &pieces, b, &|_| false);
+        let (springs, _) = hinge_springs(&flat, &pieces, b, &|_| false);
         assert!(energy(&springs, &flat).abs() < 1e-9 * 0.5 * b * 16.0 * 0.39f64.powi(2));
         let kappa = 4.0;
         // Roll about an axis along z (curvature in x), so the bent energy is ½ B κ² area.
