@@ -161,41 +161,6 @@ response = { kind = "restitution", cr = 0.0, friction = 0.5 }
     }
 }
 
-/// A disc `r` across as Blender fills a circle of `sides`: one fan of needles from a point
-/// on its rim, each triangle then cut into four, twice.
-fn fan_disc(r: f64, sides: usize) -> (Vec<Vec3>, Vec<Vec<u32>>) {
-    let mut v: Vec<Vec3> = (0..sides)
-        .map(|k| {
-            let a = std::f64::consts::TAU * k as f64 / sides as f64;
-            Vec3::new(r * a.cos(), 0.0, r * a.sin())
-        })
-        .collect();
-    let mut faces: Vec<Vec<u32>> = (1..sides as u32 - 1).map(|k| vec![0, k, k + 1]).collect();
-    for _ in 0..2 {
-        let mut middle = std::collections::BTreeMap::new();
-        let mut finer = Vec::new();
-        for t in &faces {
-            let m: Vec<u32> = (0..3)
-                .map(|k| {
-                    let (p, q) = (t[k], t[(k + 1) % 3]);
-                    *middle.entry((p.min(q), p.max(q))).or_insert_with(|| {
-                        v.push(0.5 * (v[p as usize] + v[q as usize]));
-                        v.len() as u32 - 1
-                    })
-                })
-                .collect();
-            finer.extend([
-                vec![t[0], m[0], m[2]],
-                vec![m[0], t[1], m[1]],
-                vec![m[2], m[1], t[2]],
-                m,
-            ]);
-        }
-        faces = finer;
-    }
-    (v, faces)
-}
-
 /// A cotton disc 30 cm across made as Blender fills a circle (a fan of needles, edges
 /// 1.8 mm to 7.5 cm): the build says its bending is fitted to the points, naming the file,
 /// and its bending sets no step: the highest frequency of the body with its bending is
@@ -204,7 +169,8 @@ fn fan_disc(r: f64, sides: usize) -> (Vec<Vec3>, Vec<Vec<u32>>) {
 #[test]
 fn a_disc_of_needles_bends_without_setting_the_step() {
     let dir = folder("fan-disc");
-    let (v, f) = fan_disc(0.15, 128);
+    let (v, f) = hooke_scene::example_meshes::fan_disc(0.15, 128, 2);
+    let v: Vec<Vec3> = v.iter().map(|p| Vec3::from(*p)).collect();
     std::fs::write(dir.join("fan.obj"), obj(&v, &f)).unwrap();
     let omega = |bending: &str| {
         let text = format!(

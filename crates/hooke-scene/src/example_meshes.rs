@@ -127,6 +127,47 @@ pub fn disc(radius: f64, rings: usize, seed: u64) -> (Vec<[f64; 3]>, Vec<Vec<u32
     (vertices, faces)
 }
 
+/// A disc of `radius` in the x-z plane as Blender fills a circle of `sides`: one fan of
+/// needles from a point on its rim, each triangle then cut into four `subdivisions` times
+/// (a mesh with slivers, for the tests of docs/physics.md §1.1, "Bending on slivers").
+pub fn fan_disc(radius: f64, sides: usize, subdivisions: usize) -> (Vec<[f64; 3]>, Vec<Vec<u32>>) {
+    let mut v: Vec<[f64; 3]> = (0..sides)
+        .map(|k| {
+            let a = TAU * k as f64 / sides as f64;
+            [radius * a.cos(), 0.0, radius * a.sin()]
+        })
+        .collect();
+    let mut faces: Vec<Vec<u32>> = (1..sides as u32 - 1).map(|k| vec![0, k, k + 1]).collect();
+    for _ in 0..subdivisions {
+        let mut middle = std::collections::BTreeMap::new();
+        let mut finer = Vec::new();
+        for t in &faces {
+            let m: Vec<u32> = (0..3)
+                .map(|k| {
+                    let (p, q) = (t[k], t[(k + 1) % 3]);
+                    *middle.entry((p.min(q), p.max(q))).or_insert_with(|| {
+                        let (a, b) = (v[p as usize], v[q as usize]);
+                        v.push([
+                            0.5 * (a[0] + b[0]),
+                            0.5 * (a[1] + b[1]),
+                            0.5 * (a[2] + b[2]),
+                        ]);
+                        v.len() as u32 - 1
+                    })
+                })
+                .collect();
+            finer.extend([
+                vec![t[0], m[0], m[2]],
+                vec![m[0], t[1], m[1]],
+                vec![m[2], m[1], t[2]],
+                m,
+            ]);
+        }
+        faces = finer;
+    }
+    (v, faces)
+}
+
 /// `builtin:round-cloth.obj`: a round tablecloth 1.8 m across, 30 rings of irregular
 /// triangles (2791 vertices).
 pub fn round_cloth_obj() -> String {

@@ -158,14 +158,7 @@ pub(crate) fn hinge_springs(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Energy of zero-rest springs at positions `x`.
-    fn energy(springs: &[((u32, u32), f64)], x: &[Vec3]) -> f64 {
-        springs
-            .iter()
-            .map(|((i, j), k)| 0.5 * k * (x[*i as usize] - x[*j as usize]).norm_squared())
-            .sum()
-    }
+    use crate::body::mesh::bending::rolls::rolled_errors;
 
     /// A sheet rolled onto a cylinder of curvature κ either way stores `½ B κ²` per area:
     /// within 5 % on a regular mesh (its boundary's hinges are missing), within 10 % on an
@@ -173,93 +166,23 @@ mod tests {
     #[test]
     fn a_rolled_sheet_stores_half_b_kappa_squared_per_area() {
         for (jitter, tolerance) in [(0.0, 0.05), (0.3, 0.1)] {
-            rolled(jitter, tolerance);
+            let errors = rolled_errors(jitter, &|x, polygons, b| {
+                let pieces: Vec<Piece> = polygons
+                    .iter()
+                    .enumerate()
+                    .map(|(f, t)| Piece {
+                        corners: [t[0], t[1], t[2]],
+                        face: f as u32,
+                        cut: 0,
+                        weight: 1.0,
+                    })
+                    .collect();
+                hinge_springs(x, &pieces, b, &|_| false).0
+            });
+            assert!(
+                errors.iter().all(|e| e.abs() < tolerance),
+                "{jitter}: {errors:?}"
+            );
         }
-    }
-
-    fn rolled(jitter: f64, tolerance: f64) {
-        // A 40 × 40 grid of points jittered by up to 0.3 spacing, diagonals random.
-
-        let n = 40;
-        let h = 0.01;
-        let mut seed = 12345u64;
-        let mut rand = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64) / ((1u64 << 53) as f64)
-        };
-        let mut flat = Vec::new();
-        for i in 0..n {
-            for j in 0..n {
-                let wobble = |r: f64| {
-                    if i == 0 || j == 0 || i == n - 1 || j == n - 1 {
-                        0.0
-                    } else {
-                        (r - 0.5) * jitter * h
-                    }
-                };
-                flat.push(Vec3::new(
-                    i as f64 * h + wobble(rand()),
-                    0.0,
-                    j as f64 * h + wobble(rand()),
-                ));
-            }
-        }
-        let id = |i: usize, j: usize| (i * n + j) as u32;
-        let mut tris = Vec::new();
-        for i in 0..n - 1 {
-            for j in 0..n - 1 {
-                if rand() < 0.5 {
-                    tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                    tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-                } else {
-                    tris.push([id(i, j), id(i + 1, j), id(i, j + 1)]);
-                    tris.push([id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-                }
-            }
-        }
-        let b = 5e-6;
-        let pieces: Vec<Piece> = tris
-            .iter()
-            .enumerate()
-            .map(|(f, &corners)| Piece {
-                corners,
-                face: f as u32,
-                cut: 0,
-                weight: 1.0,
-            })
-            .collect();
-        let (springs, _) = hinge_springs(&flat, &pieces, b, &|_| false);
-        assert!(energy(&springs, &flat).abs() < 1e-9 * 0.5 * b * 16.0 * 0.39f64.powi(2));
-        let kappa = 4.0;
-        // Roll about an axis along z (curvature in x), so the bent energy is ½ B κ² area.
-        let rolled: Vec<Vec3> = flat
-            .iter()
-            .map(|p| {
-                let a = p.x * kappa;
-                Vec3::new(a.sin() / kappa, (1.0 - a.cos()) / kappa, p.z)
-            })
-            .collect();
-        let area = ((n - 1) as f64 * h).powi(2);
-        let want = 0.5 * b * kappa * kappa * area;
-        let got = energy(&springs, &rolled);
-        assert!(
-            (got / want - 1.0).abs() < tolerance,
-            "{jitter}: {got} vs {want}"
-        );
-        // Rolled the other way round (curvature in z) too.
-        let rolled: Vec<Vec3> = flat
-            .iter()
-            .map(|p| {
-                let a = p.z * kappa;
-                Vec3::new(p.x, (1.0 - a.cos()) / kappa, a.sin() / kappa)
-            })
-            .collect();
-        let got = energy(&springs, &rolled);
-        assert!(
-            (got / want - 1.0).abs() < tolerance,
-            "{jitter}: {got} vs {want}"
-        );
     }
 }

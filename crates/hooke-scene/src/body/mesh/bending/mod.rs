@@ -12,6 +12,8 @@
 
 pub(crate) mod fitted;
 pub(crate) mod hinges;
+#[cfg(test)]
+mod rolls;
 
 /// Zero-rest-length springs summed per pair of particles: `((i, j), ks)`, `i < j`, in
 /// ascending order of the pair.
@@ -34,9 +36,6 @@ pub(crate) fn springs(
     if steepest <= SLIVER {
         (on_hinges, None)
     } else {
-        (
-            fitted::laplacian_springs(x, polygons, bending),
-            Some(steepest),
-        )
+        (fitted::fitted_springs(x, polygons, bending), Some(steepest))
     }
 }
