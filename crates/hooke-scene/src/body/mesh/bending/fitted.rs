@@ -1,7 +1,7 @@
 //! Bending on a mesh of any triangulation: `½ B Σ_v A_v (|x_uu|² + 2|x_uw|² + |x_ww|²)`,
 //! the second derivatives of the position fitted to each vertex's neighbourhood at rest
 //! rather than read off its triangles' angles, written as zero-rest-length springs
-//! (docs/physics.md §1.1, "Meshes"), on meshes with slivers.
+//! (docs/physics.md §1.1, "Bending on slivers"), on meshes with slivers.
 //!
 //! For a bend that keeps lengths, `x_ab` is the second fundamental form times the normal,
 //! so the sum is `κ₁² + κ₂²`: the plate's energy at Poisson's ratio 0, and for a roll the
@@ -20,8 +20,12 @@ use crate::body::mesh::bending::PairSprings;
 use crate::body::mesh::sheet::polygon_area;
 use hooke_core::Vec3;
 use nalgebra::{Matrix5, Vector5};
+use rayon::prelude::*;
 use std::cmp::Reverse;
-use std::collections::{BTreeMap, BinaryHeap};
+use std::collections::{BTreeMap, BinaryHeap, HashMap};
+
+/// A vertex's neighbours, ascending, each with its weights for `x_uu`, `x_uw` and `x_ww`.
+type Stencil = Vec<(u32, [f64; 3])>;
 
 /// The sectors of a vertex's tangent plane that its neighbours are chosen from.
 const SECTORS: usize = 8;
@@ -43,8 +47,7 @@ const SPANS: f64 = 1e-4;
 
 /// The zero-rest-length springs of the bending energy of `polygons` (corner indices into
 /// `x`, the rest shape) for a rigidity `bending` (N·m), summed per pair of particles, in
-/// ascending order of the pair. A vertex whose three rings do not span the tangent plane
-/// (a strip one face wide) adds none.
+/// ascending order of the pair. A vertex with no fit (a strip one face wide) adds none.
 pub(crate) fn fitted_springs(x: &[Vec3], polygons: &[Vec<u32>], bending: f64) -> PairSprings {
     let n = x.len();
     let mut ring: Vec<Vec<u32>> = vec![Vec::new(); n];
@@ -66,9 +69,15 @@ pub(crate) fn fitted_springs(x: &[Vec3], polygons: &[Vec<u32>], bending: f64) ->
         r.sort_unstable();
         r.dedup();
     }
+    // Each vertex's search is its own, so they run in parallel; the sums below run in
+    // vertex order, the same bits on any number of threads.
+    let stencils: Vec<Option<Stencil>> = (0..n)
+        .into_par_iter()
+        .map(|v| second_derivatives(v, x, &ring, normal[v]))
+        .collect();
     let mut out: BTreeMap<(u32, u32), f64> = BTreeMap::new();
-    for v in 0..n {
-        let Some(stencil) = second_derivatives(v, x, &ring, normal[v]) else {
+    for (v, stencil) in stencils.into_iter().enumerate() {
+        let Some(stencil) = stencil else {
             continue;
         };
         // `x_uu`, `x_uw` (counted twice: the Hessian's two off-diagonal entries) and `x_ww`.
@@ -99,12 +108,7 @@ pub(crate) fn fitted_springs(x: &[Vec3], polygons: &[Vec<u32>], bending: f64) ->
 /// away, and, if those do not span the quadratics (a boundary, where half the sectors are
 /// empty), its next at least half as far again. A vertex a hair away (a sliver's short
 /// edge) is never taken, and the weights scale as `1/ρ²`.
-fn second_derivatives(
-    v: usize,
-    x: &[Vec3],
-    ring: &[Vec<u32>],
-    normal: Vec3,
-) -> Option<Vec<(u32, [f64; 3])>> {
+fn second_derivatives(v: usize, x: &[Vec3], ring: &[Vec<u32>], normal: Vec3) -> Option<Stencil> {
     let normal = normal.try_normalize(0.0)?;
     // Any two directions across the normal.
     let seed = if normal.x.abs() < 0.9 {
@@ -125,9 +129,10 @@ fn second_derivatives(
     // neighbour (past a boundary, sectors stay empty; a sliver's long edge sets how far
     // its corner must look).
     let reach = 3.0 * ring[v].iter().map(|&w| distance(w)).fold(0.0, f64::max);
-    let mut best: BTreeMap<u32, f64> = BTreeMap::from([(v as u32, 0.0)]);
+    let mut best: HashMap<u32, f64> = HashMap::from([(v as u32, 0.0)]);
     let mut queue = BinaryHeap::from([Reverse((0u64, v as u32))]);
-    let mut reached: Vec<u32> = Vec::new();
+    // Each vertex reached with its sector and distance, worked out once.
+    let mut reached: Vec<(u32, usize, f64)> = Vec::new();
     let mut nearest = [f64::INFINITY; SECTORS];
     let mut filled_at = 0.0f64;
     while let Some(Reverse((bits, w))) = queue.pop() {
@@ -159,19 +164,19 @@ fn second_derivatives(
             filled_at = along;
         }
         nearest[s] = nearest[s].min(d);
-        reached.push(w);
+        reached.push((w, s, d));
     }
     let rho = nearest
         .iter()
         .filter(|d| d.is_finite())
         .fold(0.0f64, |a, &d| a.max(d));
-    reached.sort_unstable();
+    reached.sort_unstable_by_key(|r| r.0);
     // The sector's nearest vertex at least `from` away, as `(distance, index)`.
     let pick = |s: usize, from: f64| {
         reached
             .iter()
-            .filter(|&&w| sector(w) == s && distance(w) >= from)
-            .map(|&w| (distance(w), w))
+            .filter(|r| r.1 == s && r.2 >= from)
+            .map(|r| (r.2, r.0))
             .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
     };
     let mut stencil: Vec<u32> = Vec::new();
@@ -200,7 +205,7 @@ fn second_derivatives(
 
 /// The weights of `stencil` for the three second derivatives at `v`, if it spans the
 /// quadratics of the plane of `t1`, `t2`.
-fn fit(v: usize, x: &[Vec3], stencil: &[u32], t1: Vec3, t2: Vec3) -> Option<Vec<(u32, [f64; 3])>> {
+fn fit(v: usize, x: &[Vec3], stencil: &[u32], t1: Vec3, t2: Vec3) -> Option<Stencil> {
     let mut stencil = stencil.to_vec();
     stencil.sort_unstable();
     let plane: Vec<(f64, f64)> = stencil
