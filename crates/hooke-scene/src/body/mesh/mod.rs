@@ -14,7 +14,7 @@ use crate::scene::Topology;
 use crate::spec::{BodySpec, PinRegion, Pins, SpringParams};
 use hooke_collide::PolygonMesh;
 use hooke_core::{Spring, SpringKind, Vec3};
-use sheet::{Sheet, canonical, polygon_area};
+use sheet::{Sheet, canonical};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -148,14 +148,7 @@ fn spring(
 
 /// Each particle's mass: the density times an equal share of each face's area.
 fn fabric_masses(sheet: &Sheet, m: &Material) -> Vec<f64> {
-    let mut out = vec![0.0; sheet.local.len()];
-    for p in &sheet.polygons {
-        let share = m.density * polygon_area(p, &sheet.local) / p.len() as f64;
-        for &v in p {
-            out[v as usize] += share;
-        }
-    }
-    out
+    sheet::vertex_shares(&sheet.local, &sheet.polygons, m.density)
 }
 
 /// The membrane springs of each face (its sides, a quad's diagonals, an n-gon's fan),

@@ -281,6 +281,19 @@ pub(crate) fn polygon_area(p: &[u32], x: &[Vec3]) -> f64 {
     0.5 * n.norm()
 }
 
+/// Each vertex's equal share of the area of every polygon it is a corner of, times
+/// `per_area` (a density gives the masses; 1 the areas themselves).
+pub(crate) fn vertex_shares(x: &[Vec3], polygons: &[Vec<u32>], per_area: f64) -> Vec<f64> {
+    let mut out = vec![0.0; x.len()];
+    for p in polygons {
+        let share = per_area * polygon_area(p, x) / p.len() as f64;
+        for &v in p {
+            out[v as usize] += share;
+        }
+    }
+    out
+}
+
 /// The diagonal of the points' bounding box.
 pub(crate) fn bounds_diagonal(x: &[Vec3]) -> f64 {
     let (lo, hi) = x.iter().fold(

@@ -12,6 +12,17 @@ pub(super) fn energy(springs: &[((u32, u32), f64)], x: &[Vec3]) -> f64 {
         .sum()
 }
 
+/// Points of the x–z plane rolled onto a cylinder of curvature `kappa` about an axis
+/// along z, keeping their lengths.
+pub(super) fn rolled_about_z(x: &[Vec3], kappa: f64) -> Vec<Vec3> {
+    x.iter()
+        .map(|p| {
+            let a = p.x * kappa;
+            Vec3::new(a.sin() / kappa, (1.0 - a.cos()) / kappa, p.z)
+        })
+        .collect()
+}
+
 /// A bending model: the springs of rest positions, polygons and a rigidity.
 pub(super) type Model = dyn Fn(&[Vec3], &[Vec<u32>], f64) -> PairSprings;
 
@@ -66,13 +77,7 @@ pub(super) fn rolled_errors(jitter: f64, springs_of: &Model) -> [f64; 2] {
     let area = ((n - 1) as f64 * h).powi(2);
     let want = 0.5 * b * kappa * kappa * area;
     // Rolled about an axis along z (curvature in x), then along x (curvature in z).
-    let about_z: Vec<Vec3> = flat
-        .iter()
-        .map(|p| {
-            let a = p.x * kappa;
-            Vec3::new(a.sin() / kappa, (1.0 - a.cos()) / kappa, p.z)
-        })
-        .collect();
+    let about_z = rolled_about_z(&flat, kappa);
     let about_x: Vec<Vec3> = flat
         .iter()
         .map(|p| {
