@@ -6,6 +6,7 @@ with Hooke's trajectory (a row per vertex of the file). Not part of the test sui
 a large download); run by hand:
 
     python check_blender_mesh.py make sheet.obj
+    python check_blender_mesh.py make-sleeve sleeve.obj   # tests/fixtures/blender-sleeve.obj
     hooke run sheet.toml --export run.pc2 --trajectory run.csv   # sheet.toml: docs/output.md
     python check_blender_mesh.py play sheet.obj run.pc2 run.csv
 
@@ -45,6 +46,25 @@ def make(path):
     bpy.ops.wm.obj_export(filepath=path, export_uv=True, export_normals=False, export_materials=False)
 
 
+def make_sleeve(path):
+    """An open cylinder as a Blender user makes a sleeve: 12 cm across, 60 cm long, its axis
+    along x, 56 cm above the ground, 32 sides cut into 12 rings, triangulated (Beauty)."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.mesh.primitive_cylinder_add(
+        vertices=32, radius=0.06, depth=0.6, end_fill_type="NOTHING", rotation=(0, 1.5707963, 0), location=(0, 0, 0.56)
+    )
+    bpy.ops.object.transform_apply(location=True, rotation=True, scale=True)
+    me = bpy.context.active_object.data
+    bm = bmesh.new()
+    bm.from_mesh(me)
+    along = [e for e in bm.edges if abs(e.verts[0].co.x - e.verts[1].co.x) > 0.3]
+    bmesh.ops.subdivide_edges(bm, edges=along, cuts=11, use_grid_fill=True)
+    bmesh.ops.triangulate(bm, faces=bm.faces[:], quad_method="BEAUTY")
+    bm.to_mesh(me)
+    bm.free()
+    bpy.ops.wm.obj_export(filepath=path, export_uv=False, export_normals=False, export_materials=False)
+
+
 def play(obj_path, pc2, traj):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     bpy.ops.wm.obj_import(filepath=obj_path)
@@ -72,4 +92,4 @@ def play(obj_path, pc2, traj):
 
 if __name__ == "__main__":
     args = sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else sys.argv[1:]
-    {"make": make, "play": play}[args[0]](*args[1:])
+    {"make": make, "make-sleeve": make_sleeve, "play": play}[args[0]](*args[1:])

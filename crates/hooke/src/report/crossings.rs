@@ -58,13 +58,19 @@ pub fn count(cloth: &[(Tri, [u32; 3])], colliders: &[Tri]) -> (usize, usize) {
             }
         }
     }
-    // Cloth against cloth: a sweep along x over the boxes.
+    (against_colliders, cloth_pairs(cloth).len())
+}
+
+/// The cloth triangles that cross each other in one state, as pairs of indices into
+/// `cloth` (see [`count`]), lower index first, in the order a sweep along x finds them.
+pub fn cloth_pairs(cloth: &[(Tri, [u32; 3])]) -> Vec<(usize, usize)> {
+    let boxes: Vec<_> = cloth.iter().map(|(t, _)| bounds(t)).collect();
     let mut order: Vec<usize> = (0..cloth.len()).collect();
-    order.sort_by(|&a, &b| cloth_boxes[a].0.x.total_cmp(&cloth_boxes[b].0.x));
-    let mut among_cloth = 0;
+    order.sort_by(|&a, &b| boxes[a].0.x.total_cmp(&boxes[b].0.x));
+    let mut pairs = Vec::new();
     for (i, &a) in order.iter().enumerate() {
         for &b in &order[i + 1..] {
-            if cloth_boxes[b].0.x > cloth_boxes[a].1.x {
+            if boxes[b].0.x > boxes[a].1.x {
                 break;
             }
             let (ta, ia) = &cloth[a];
@@ -72,12 +78,12 @@ pub fn count(cloth: &[(Tri, [u32; 3])], colliders: &[Tri]) -> (usize, usize) {
             if ia.iter().any(|v| ib.contains(v)) {
                 continue;
             }
-            if overlap(&cloth_boxes[a], &cloth_boxes[b]) && triangles_cross(ta, tb) {
-                among_cloth += 1;
+            if overlap(&boxes[a], &boxes[b]) && triangles_cross(ta, tb) {
+                pairs.push((a.min(b), a.max(b)));
             }
         }
     }
-    (against_colliders, among_cloth)
+    pairs
 }
 
 #[cfg(test)]

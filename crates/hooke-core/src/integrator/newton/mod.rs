@@ -13,7 +13,10 @@
 //! * A backtracking line search halves the step until the energy falls, every trial point
 //!   clipped to its particle's bounds from the last detection (block descent's, with its
 //!   re-detection when a hundredth of the particles wait at them): no surface crosses a
-//!   collider or another surface, at any step.
+//!   collider or another surface, at any step. A search that finds no lower energy does not
+//!   move. The detections within a step centre each ball where its particle is
+//!   ([`Centres::Detected`]), so that the current iterate is always a trial the search
+//!   may keep.
 //! * The step ends when its last Newton step (the search direction, before the line search)
 //!   moved no free particle faster than the tolerance of its [`StopRule`] (IPC's rule), or
 //!   at its iteration budget.
@@ -23,6 +26,7 @@
 
 mod factor;
 
+use super::vbd::detect::Centres;
 use super::vbd::local::{Local, friction_stiffness};
 use super::vbd::{clip, finish, keep_momentum, prepare};
 use super::{StepReport, StopRule, Sym3, Workspace};
@@ -38,7 +42,7 @@ pub(super) const STABILITY_RADIUS: f64 = f64::INFINITY;
 pub(super) const CG_TOLERANCE: f64 = 1e-4;
 /// Conjugate-gradient iterations at most per Newton iteration.
 pub(super) const CG_MAX_ITERATIONS: usize = 2000;
-/// Halvings of the line search before a step is taken as it is.
+/// Halvings of the line search before it gives up and keeps the iterate where it is.
 const HALVINGS: usize = 12;
 /// A line search that ends below this share of the Newton step has stalled.
 const STALLED: f64 = 0.01;
@@ -153,9 +157,15 @@ pub(super) fn step(
                     to
                 };
             }
-            if halving == HALVINGS
-                || local.energy(&nb.trial, &p.x, &nb.pinned, &mut nb.parts) <= before
-            {
+            if local.energy(&nb.trial, &p.x, &nb.pinned, &mut nb.parts) <= before {
+                break;
+            }
+            if halving == HALVINGS {
+                // No share of the step lowers the energy: taking it anyway adds energy each
+                // iteration (a sleeve landing on its own folds went from 0.066 J to 0.25 J
+                // within one step so, docs/physics.md §4.2).
+                nb.trial.copy_from_slice(&p.x);
+                alpha = 0.0;
                 break;
             }
             alpha *= 0.5;
@@ -176,13 +186,23 @@ pub(super) fn step(
             converged = true;
             break;
         }
+        // A direction that no share of lowers the energy, with no bound in the way, is the
+        // same at the next iteration: the step ends here, unsolved.
+        if alpha == 0.0 && held == 0 {
+            break;
+        }
         // Detect again when enough particles wait at their bounds, when only they are left
         // to move, or when they stall the line search (a Newton step clipped at the bounds
         // need not be a descent).
         let stalled = alpha < STALLED;
         if (held >= enough || ((settled || stalled) && held > 0)) && iterations < rule.iterations {
-            b.detection
-                .detect(model, p, &b.graph, (&p.x, &b.target), dt);
+            b.detection.detect(
+                model,
+                p,
+                &b.graph,
+                (&p.x, &b.target),
+                (dt, Centres::Detected),
+            );
             b.detected.copy_from_slice(&p.x);
             b.detections += 1;
             b.times.detection += clock.lap();

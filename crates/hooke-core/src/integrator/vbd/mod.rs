@@ -36,7 +36,7 @@ use super::{StepReport, StopRule, Workspace};
 use crate::integrator::Sym3;
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
-use detect::Detection;
+use detect::{Centres, Detection};
 use graph::Graph;
 use lanes::{LANES, Lanes};
 use local::{Block, Gaps, Local};
@@ -214,8 +214,13 @@ pub(in crate::integrator) fn step(
         // Detect again when enough particles wait at their bounds, or when they are all
         // that is left to move.
         if (held >= enough || (settled && held > 0)) && iterations < rule.iterations {
-            b.detection
-                .detect(model, p, &b.graph, (&p.x, &b.target), dt);
+            b.detection.detect(
+                model,
+                p,
+                &b.graph,
+                (&p.x, &b.target),
+                (dt, Centres::Shifted),
+            );
             recolour(&mut b.graph, &b.detection, p);
             b.detected.copy_from_slice(&p.x);
             b.detections += 1;
@@ -308,8 +313,13 @@ pub(in crate::integrator) fn prepare(
     }
     // The targets are the step's, not the solve's: their time is the rest's.
     let _ = clock.lap();
-    b.detection
-        .detect(model, p, &b.graph, (&p.x, &b.target), dt);
+    b.detection.detect(
+        model,
+        p,
+        &b.graph,
+        (&p.x, &b.target),
+        (dt, Centres::Shifted),
+    );
     // A keyframed pin moves at its velocity over the step (docs/physics.md §1.2): implicit
     // Euler solves the free particles against where it ends, so its springs pull them along
     // within the step, and it keeps that velocity (a still pin's target is where it is).

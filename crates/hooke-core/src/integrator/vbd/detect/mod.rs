@@ -158,6 +158,19 @@ pub(in crate::integrator) struct Detection {
     pub(in crate::integrator) scale: Vec<f64>,
 }
 
+/// Where a detection centres its balls.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(in crate::integrator) enum Centres {
+    /// At the detected points moved by the step's shared translation `u` (see
+    /// `set_shift`): a falling sheet's balls fall with it. A ball may then leave out its
+    /// own detected point (where its nearest pair allows less than `u`), and every
+    /// update of that particle is taken into it, whatever its forces ask.
+    Shifted,
+    /// At the detected points: each ball holds its own, so that staying put is always
+    /// allowed (what a line search from the current iterate needs).
+    Detected,
+}
+
 impl Detection {
     /// Particle `i`'s pairs.
     #[inline]
@@ -240,14 +253,15 @@ impl Detection {
     }
 
     /// Detects at positions `x` (the current iterate), with `y` the step's inertial targets
-    /// (which set how far the search reaches and the shared translation `u`).
+    /// (which set how far the search reaches and, with [`Centres::Shifted`], the shared
+    /// translation `u`).
     pub(in crate::integrator) fn detect(
         &mut self,
         model: &Model,
         p: &Particles,
         graph: &Graph,
         (x, y): (&[Vec3], &[Vec3]),
-        dt: f64,
+        (dt, centres): (f64, Centres),
     ) {
         let n = x.len();
         let h_max = model
@@ -285,7 +299,10 @@ impl Detection {
         self.detect_colliders(model, x, collider_reach);
         self.detect_features(model, x, collider_reach, dt);
         let allowed = self.collider_allowance(model);
-        self.set_shift(p, (x, y), &allowed);
+        match centres {
+            Centres::Shifted => self.set_shift(p, (x, y), &allowed),
+            Centres::Detected => self.keep_still(p, (x, y)),
+        }
         // Surfaces are searched far enough that pairs beyond the reach stay apart however
         // far keyed pins move from the shared translation (see `set_radii`).
         let pins = self.excess.iter().fold(0.0, |a: f64, &b| a.max(b));
@@ -509,6 +526,18 @@ impl Detection {
         if u.norm() > 0.5 * room || closes_half {
             u = Vec3::zeros();
         }
+        self.set_excess(p, (x, y), u);
+    }
+
+    /// No shared translation: every ball is centred where its particle was detected, so
+    /// that it holds that point.
+    fn keep_still(&mut self, p: &Particles, (x, y): (&[Vec3], &[Vec3])) {
+        self.set_excess(p, (x, y), Vec3::zeros());
+    }
+
+    /// Sets the shared translation `u` and each keyed pin's excess over it.
+    fn set_excess(&mut self, p: &Particles, (x, y): (&[Vec3], &[Vec3]), u: Vec3) {
+        let n = x.len();
         self.shift = u;
         // A pin moves by its keys (its target less where it is; zero when still), exactly:
         // what it moves apart from `u` is room its surface pairs' free sides cannot use.
