@@ -202,7 +202,7 @@ fn newton_drapes_the_round_table_without_crossing() {
 /// No two triangles cross on any frame (the independent checker, `contact.rs`), except
 /// pairs the large steps skip (docs/physics.md §4.1): within four thicknesses of each
 /// other at rest, here one 11.8 mm edge across the sleeve's ring, which its tight creases
-/// fold through (up to 2 such pairs a step; block descent, up to 5; symplectic Euler at
+/// fold through (up to 3 such pairs a step; block descent, up to 5 a frame; symplectic at
 /// 1e-4 s, whose contacts skip only pairs within two thicknesses, none on 21 frames).
 #[test]
 fn a_blender_sleeve_lands_on_its_folds_under_newton_without_gaining_energy() {
