@@ -67,7 +67,8 @@ fn undamped_pair(integrator: Integrator) -> Simulation {
     )
 }
 
-fn energy(sim: &Simulation) -> f64 {
+/// A state's total energy: kinetic plus potential (springs, gravity, penalty springs).
+pub(crate) fn energy(sim: &Simulation) -> f64 {
     let s = hooke_core::Summary::of(sim.model(), sim.particles());
     s.kinetic + s.potential
 }

@@ -225,13 +225,7 @@ response = { kind = "restitution", cr = 0.0, friction = 0.5 }
 "#;
     let mut scene = crate::meshes::build(text, &dir).unwrap();
     scene.simulation.watch_energy(false);
-    let energy = |scene: &Scene| {
-        let p = scene.simulation.particles();
-        let kinetic: f64 = (0..p.x.len())
-            .map(|i| 0.5 * p.mass[i] * p.v[i].norm_squared())
-            .sum();
-        kinetic + scene.simulation.model().potential_energy(&p.mass, &p.x)
-    };
+    let energy = |scene: &Scene| crate::conservation::energy(&scene.simulation);
     let faces = scene.bodies[0].faces();
     let rest = scene.simulation.particles().x.clone();
     let skip = scene.simulation.model().self_contact_skip();
