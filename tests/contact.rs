@@ -341,7 +341,11 @@ fn implicit_at_a_frame_per_step_says_when_the_cloth_first_crosses_the_table() {
     let crossed = first_crossing.expect("the cloth crossed the table at 1/60 s");
     let notice = first_notice.expect("a crossing was said");
     assert_eq!(notice.step, crossed, "{notice:?}");
-    assert_eq!(notice.collider, 1, "{notice:?}");
+    assert_eq!(
+        notice.through,
+        hooke_core::Through::Collider(1),
+        "{notice:?}"
+    );
     assert!(
         matches!(
             notice.cause,

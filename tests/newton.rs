@@ -5,7 +5,6 @@
 //! the bits do not depend on the thread count. (The denim cantilever is in `material.rs`.)
 
 use crate::common::builtin;
-use hooke::report::crossings::Tri;
 use hooke_core::{Integrator, Vec3};
 use hooke_scene::world::World;
 use hooke_scene::{Overrides, Scene};
@@ -203,71 +202,28 @@ fn newton_drapes_the_round_table_without_crossing() {
 /// pairs the large steps skip (docs/physics.md §4.1): within four thicknesses of each
 /// other at rest, here one 11.8 mm edge across the sleeve's ring, which its tight creases
 /// fold through (up to 3 such pairs a step; block descent, up to 5 a frame; symplectic at
-/// 1e-4 s, whose contacts skip only pairs within two thicknesses, none on 21 frames).
+/// 1e-4 s, whose contacts skip only pairs within two thicknesses, none on 21 frames); the
+/// run says so at each step one is (`creases::step_watching_folds`).
 #[test]
 fn a_blender_sleeve_lands_on_its_folds_under_newton_without_gaining_energy() {
-    let dir = crate::common::root().join("tests/fixtures");
-    let text = r#"
-name = "sleeve"
-[simulation]
-integrator = "newton"
-dt = 0.016666666666666666
-duration = 1.0
-every = 1
-[[body]]
-name = "sleeve"
-self_collision = true
-shape = { kind = "mesh", path = "blender-sleeve.obj" }
-material = { preset = "silk" }
-[[collider]]
-shape = { kind = "ground", height = 0.0 }
-response = { kind = "restitution", cr = 0.0, friction = 0.5 }
-"#;
-    let mut scene = crate::meshes::build(text, &dir).unwrap();
+    let mut scene = crate::creases::blender_sleeve("newton");
     scene.simulation.watch_energy(false);
     let energy = |scene: &Scene| crate::conservation::energy(&scene.simulation);
-    let faces = scene.bodies[0].faces();
-    let rest = scene.simulation.particles().x.clone();
-    let skip = scene.simulation.model().self_contact_skip();
-    // The nearest two corners of triangles `a` and `b` at rest.
-    let apart = |a: &[u32], b: &[u32]| {
-        let corners = |f: &[u32]| f.iter().map(|&i| rest[i as usize]).collect::<Vec<_>>();
-        let (ca, cb) = (corners(a), corners(b));
-        ca.iter()
-            .flat_map(|p| cb.iter().map(move |q| (p - q).norm()))
-            .fold(f64::INFINITY, f64::min)
-    };
     let start = energy(&scene);
-    let (mut highest, mut crossed, mut skipped) = (start, Vec::new(), 0usize);
-    for step in 1..=scene.steps {
-        scene.simulation.step().unwrap();
-        highest = highest.max(energy(&scene));
-        let x = &scene.simulation.particles().x;
-        let cloth: Vec<(Tri, [u32; 3])> = faces
-            .iter()
-            .map(|f| {
-                (
-                    [x[f[0] as usize], x[f[1] as usize], x[f[2] as usize]],
-                    [f[0], f[1], f[2]],
-                )
-            })
-            .collect();
-        let mut here = 0;
-        for (a, b) in hooke::report::crossings::cloth_pairs(&cloth) {
-            if apart(&faces[a], &faces[b]) <= skip * (1.0 + 1e-9) {
-                here += 1;
-            } else {
-                crossed.push(format!("step {step}: triangles {a} and {b}"));
-            }
-        }
-        skipped = skipped.max(here);
-    }
+    let mut highest = start;
+    let folds = crate::creases::step_watching_folds(&mut scene, |scene| {
+        highest = highest.max(energy(scene));
+    });
     assert!(
         highest <= start * (1.0 + 1e-3),
         "the energy rose from {start:.4e} J to {highest:.4e} J"
     );
-    assert!(crossed.is_empty(), "{}", crossed.join("\n"));
-    assert!(skipped <= 4, "{skipped} skipped pairs crossed at one step");
+    folds.assert_only_skipped_pairs_cross_and_are_said();
+    assert!(
+        folds.most <= 4,
+        "{} skipped pairs crossed at one step",
+        folds.most
+    );
     let top = scene
         .simulation
         .particles()

@@ -70,7 +70,7 @@ pub use model::{Attachment, ColliderSlot, Model};
 pub use number::{Approx, Num};
 pub use particles::{Particles, SANE_BOUND, Vec3};
 pub use simulation::divergence::Divergence;
-pub use simulation::notice::{Cause, Notice};
+pub use simulation::notice::{Cause, Notice, Through};
 pub use simulation::renumber::Renumbering;
 pub use simulation::stability::StabilityEstimate;
 pub use simulation::start::{PushedOut, StartInside};

@@ -40,16 +40,29 @@ fn tally_notices(scene: &Scene) {
                     "the collider squeezed it faster than the parts of a step could follow"
                         .to_string()
                 }
+                Cause::Crease { .. } => {
+                    "it folded tighter than the pairs self-contact skips".to_string()
+                }
             };
             reporter().warn(&format!(
-                "a surface of body {} ended {steps} steps in all through collider[{}] ({}), \
-                 the first at step {}: {why}",
+                "a surface of body {} ended {steps} steps in all through {}, the first at step \
+                 {}: {why}",
                 body_of(scene, n.particle),
-                n.collider,
-                scene.simulation.model().colliders[n.collider].shape.name(),
+                through(scene, n.through),
                 n.step
             ));
         }
+    }
+}
+
+/// What a notice's surface passed through, as said.
+fn through(scene: &Scene, through: hooke_core::Through) -> String {
+    match through {
+        hooke_core::Through::Collider(k) => format!(
+            "collider[{k}] ({})",
+            scene.simulation.model().colliders[k].shape.name()
+        ),
+        hooke_core::Through::Itself(_) => "itself".to_string(),
     }
 }
 
@@ -65,17 +78,20 @@ fn body_of(scene: &Scene, particle: usize) -> String {
         )
 }
 
-/// One notice as a sentence: when, which body through which collider, and why.
+/// One notice as a sentence: when, which body through which collider (or itself), and why.
 pub fn describe(scene: &Scene, n: &hooke_core::Notice) -> String {
+    let promise = match n.through {
+        hooke_core::Through::Collider(_) => "which the run promised not to let happen",
+        hooke_core::Through::Itself(_) => "which self-contact does not keep out there",
+    };
     format!(
-        "step {} (t = {} s): a surface of body {} (particle {}) ended the step through \
-         collider[{}] ({}), which the run promised not to let happen: {}",
+        "step {} (t = {} s): a surface of body {} (particle {}) ended the step through {}, \
+         {promise}: {}",
         n.step,
         hooke_core::Approx(n.time),
         body_of(scene, n.particle),
         n.particle,
-        n.collider,
-        scene.simulation.model().colliders[n.collider].shape.name(),
+        through(scene, n.through),
         n.cause
     )
 }

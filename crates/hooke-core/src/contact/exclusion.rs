@@ -39,6 +39,8 @@ use super::proximity::{point_triangle_distance, segment_distance};
 #[cfg(doc)]
 use crate::model::Model;
 use crate::particles::Vec3;
+use folds::Skipped;
+pub(crate) use folds::{Folds, Plane};
 use rayon::prelude::*;
 
 /// At most this many particles reached by one search along the edges.
@@ -56,6 +58,10 @@ pub(crate) struct Exclusion {
     triangles: Vec<u32>,
     edge_start: Vec<u32>,
     edges: Vec<u32>,
+    /// The triangle pairs only a skipped pair could bring through each other.
+    folds: Folds,
+    /// The radius `R` the lists were built with, metres.
+    radius: f64,
 }
 
 /// The surfaces whose pairs an exclusion lists: their triangles and edges (indexed as the
@@ -181,14 +187,18 @@ impl Paths {
     }
 }
 
+/// List `i` of lists in one array `all` with their starts (empty without lists).
+fn list<'a>(start: &[u32], all: &'a [u32], i: usize) -> &'a [u32] {
+    match (start.get(i), start.get(i + 1)) {
+        (Some(&a), Some(&b)) => &all[a as usize..b as usize],
+        _ => &[],
+    }
+}
+
 /// Whether `k` is in list `i` (none without lists: an exclusion that skips nothing).
 #[inline]
 fn listed(start: &[u32], all: &[u32], i: u32, k: u32) -> bool {
-    let i = i as usize;
-    match (start.get(i), start.get(i + 1)) {
-        (Some(&a), Some(&b)) => all[a as usize..b as usize].binary_search(&k).is_ok(),
-        _ => false,
-    }
+    list(start, all, i as usize).binary_search(&k).is_ok()
 }
 
 /// Lists in one array and their starts.
@@ -307,12 +317,32 @@ impl Exclusion {
             .collect();
         let (triangle_start, triangles) = flatten(triangles);
         let (edge_start, edges) = flatten(edges);
+        let skipped = Skipped {
+            triangle_start: &triangle_start,
+            triangles: &triangles,
+            edge_start: &edge_start,
+            edges: &edges,
+        };
+        let folds = Folds::new(surfaces.triangles, surfaces.edges, &adj.triangles, &skipped);
         Self {
             triangle_start,
             triangles,
             edge_start,
             edges,
+            folds,
+            radius,
         }
+    }
+
+    /// The watch on the triangle pairs that only a skipped pair could bring through each
+    /// other (`folds.rs`).
+    pub(crate) fn folds(&self) -> &Folds {
+        &self.folds
+    }
+
+    /// The radius `R` within which pairs at rest are skipped, metres.
+    pub(crate) fn radius(&self) -> f64 {
+        self.radius
     }
 
     /// Whether the pair of particle `v` and triangle `t` is skipped.
@@ -334,5 +364,6 @@ impl Exclusion {
     }
 }
 
+mod folds;
 #[cfg(test)]
 mod tests;

@@ -144,6 +144,11 @@ pub(crate) struct ContactState {
 }
 
 impl ContactState {
+    /// The pairs the contact phase skips (empty before its first step).
+    pub(crate) fn exclusion(&self) -> &Exclusion {
+        &self.exclusion
+    }
+
     /// The state for `n` particles, none held; the rest is prepared on the first step.
     pub(crate) fn new(n: usize) -> Self {
         Self {

@@ -22,7 +22,7 @@ use crate::model::{Attachment, Model};
 use crate::parallel;
 use crate::particles::{Particles, Vec3};
 use divergence::{Divergence, StepEnd};
-use notice::{Cause, Notice, Notices};
+use notice::{Cause, Notice, Notices, Through};
 use renumber::Renumbering;
 use runaway::EnergyWatch;
 use stability::StabilityEstimate;
@@ -337,6 +337,7 @@ impl Simulation {
         self.step += 1;
         self.end_pins(time + self.dt);
         self.watch_crossings(time, report);
+        self.watch_folds();
         divergence::check(StepEnd {
             model: &self.model,
             particles: &self.particles,
@@ -412,9 +413,43 @@ impl Simulation {
         self.notices.record(Notice {
             step: self.step,
             time: self.time(),
-            collider,
+            through: Through::Collider(collider),
             particle: *pinned.unwrap_or(&ids[0]) as usize,
             cause,
+        });
+    }
+
+    /// The watch on what self-contact skips (docs/physics.md §3.5): a surface found through
+    /// itself where only a skipped pair could have let it is recorded as a [`Notice`].
+    /// Looked at after every step, since nothing bounds how far a skipped pair closes; a
+    /// surface with nothing skipped has nothing to look at.
+    fn watch_folds(&mut self) {
+        let skipped = if self.integrator.solves_contacts() {
+            self.workspace.vbd.exclusion()
+        } else {
+            self.contacts.exclusion()
+        };
+        let planes = &mut self.crossings.planes;
+        let Some(ids) = skipped.folds().first_through(&self.particles.x, planes) else {
+            return;
+        };
+        let particle = ids[0] as usize;
+        let Some((surface, _)) = self
+            .model
+            .active_surfaces()
+            .find(|(_, s)| s.particles.contains(&particle))
+        else {
+            return;
+        };
+        self.notices.record(Notice {
+            step: self.step,
+            time: self.time(),
+            through: Through::Itself(surface),
+            particle,
+            cause: Cause::Crease {
+                reach: skipped.radius(),
+                integrator: self.integrator,
+            },
         });
     }
 

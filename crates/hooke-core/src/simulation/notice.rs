@@ -1,25 +1,38 @@
 //! What a step could not keep of the project's promises, said at the step where it happened
-//! (docs/physics.md §3.5): a surface that ended a step through a collider. The simulation
-//! keeps the first notice of each kind for each collider and counts the steps of the rest,
-//! so a long run says it once, when it begins, and how often at its end.
+//! (docs/physics.md §3.5): a surface that ended a step through a collider, or through
+//! itself where self-contact skips. The simulation keeps the first notice of each kind for
+//! each collider and each surface and counts the steps of the rest, so a long run says it
+//! once, when it begins, and how often at its end.
 
 use crate::integrator::Integrator;
 use crate::number::Approx;
 use std::fmt;
 
-/// A surface (a cloth's edge or triangle) that passes through a collider after a step.
+/// A surface (a cloth's edge or triangle) that passes through a collider, or through
+/// itself, after a step.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Notice {
     /// The step after which it was found (1 for the first step).
     pub step: u64,
     /// The simulated time then, seconds.
     pub time: f64,
-    /// The collider's index in the model.
-    pub collider: usize,
-    /// A particle of the edge or triangle that meets it.
+    /// What the surface passes through.
+    pub through: Through,
+    /// A particle of the edge or triangle that meets it (for a surface through itself,
+    /// an end of the edge that passes).
     pub particle: usize,
     /// Why the integrator could not keep it out.
     pub cause: Cause,
+}
+
+/// What a surface passed through.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Through {
+    /// A collider, by its index in the model.
+    Collider(usize),
+    /// The surface itself (its index among the model's surfaces): one of its triangles
+    /// through another of it.
+    Itself(usize),
 }
 
 /// Why a step left a surface through a collider.
@@ -47,6 +60,15 @@ pub enum Cause {
         /// The parts the step was taken in.
         parts: u32,
     },
+    /// The surface folded through itself where self-contact skips its pairs: a crease
+    /// tighter than the pairs its own structure was taken to hold apart
+    /// (docs/physics.md §4.1, "What self-contact skips").
+    Crease {
+        /// The skipped pairs' reach at rest, metres.
+        reach: f64,
+        /// The integrator that took the step.
+        integrator: Integrator,
+    },
 }
 
 impl Cause {
@@ -56,6 +78,7 @@ impl Cause {
             Self::LargeStep { .. } => 0,
             Self::Pinned => 1,
             Self::Squeezed { .. } => 2,
+            Self::Crease { .. } => 3,
         }
     }
 }
@@ -90,12 +113,22 @@ impl fmt::Display for Cause {
                  the body room to move aside, or key the collider slower",
                 crate::simulation::swept::MOST_PARTS
             ),
+            Self::Crease { reach, integrator } => write!(
+                f,
+                "it folded tighter than the pairs self-contact skips ({integrator} skips those \
+                 within {} mm of each other at rest and near along the surface's edges, which \
+                 only the cloth's own springs hold apart: docs/physics.md §4.1), and an edge \
+                 passed through a triangle beside it; a thinner `thickness` narrows the \
+                 skipped pairs ({} times it), so that the crease is kept open",
+                Approx(reach * 1e3),
+                if integrator.solves_contacts() { 4 } else { 2 },
+            ),
         }
     }
 }
 
-/// The notices of a run: the new ones not yet taken, and per (collider, kind) the first
-/// notice and the steps it happened in.
+/// The notices of a run: the new ones not yet taken, and per (what was passed through,
+/// kind) the first notice and the steps it happened in.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Notices {
     fresh: Vec<Notice>,
@@ -103,13 +136,13 @@ pub(crate) struct Notices {
 }
 
 impl Notices {
-    /// Records `n`: new when its collider has had none of its kind.
+    /// Records `n`: new when what it passed through has had none of its kind.
     pub(crate) fn record(&mut self, n: Notice) {
-        let key = (n.collider, n.cause.kind());
+        let key = (n.through, n.cause.kind());
         if let Some((_, count)) = self
             .tally
             .iter_mut()
-            .find(|(first, _)| (first.collider, first.cause.kind()) == key)
+            .find(|(first, _)| (first.through, first.cause.kind()) == key)
         {
             *count += 1;
         } else {
@@ -138,7 +171,7 @@ mod tests {
         let at = |step, collider, cause| Notice {
             step,
             time: step as f64,
-            collider,
+            through: Through::Collider(collider),
             particle: 0,
             cause,
         };
@@ -147,10 +180,29 @@ mod tests {
         n.record(at(4, 1, Cause::Pinned));
         n.record(at(4, 2, Cause::Pinned));
         n.record(at(5, 1, Cause::Squeezed { parts: 9 }));
+        let crease = Cause::Crease {
+            reach: 0.02,
+            integrator: Integrator::Vbd,
+        };
+        let folded = |step| Notice {
+            through: Through::Itself(1),
+            ..at(step, 1, crease)
+        };
+        n.record(folded(6));
+        n.record(folded(7));
         let fresh = n.take();
-        assert_eq!(fresh.iter().map(|n| n.step).collect::<Vec<_>>(), [3, 4, 5]);
+        assert_eq!(
+            fresh.iter().map(|n| n.step).collect::<Vec<_>>(),
+            [3, 4, 5, 6]
+        );
         assert!(n.take().is_empty());
         assert_eq!(n.tally()[0].1, 2);
+        assert_eq!(
+            n.tally()[3].1,
+            2,
+            "a surface through itself is counted apart"
+        );
+        assert!(crease.to_string().contains("within 20 mm"));
         assert!(Cause::Squeezed { parts: 9 }.to_string().contains("9 parts"));
     }
 }

@@ -33,6 +33,8 @@ pub(crate) struct CrossingWatch {
     particles: Vec<u32>,
     /// The thinnest contact thickness of the active surfaces (infinite without one).
     pub(crate) thickness: f64,
+    /// The watch on what self-contact skips: its triangles' planes, kept between steps.
+    pub(crate) planes: Vec<crate::contact::exclusion::Plane>,
 }
 
 impl CrossingWatch {

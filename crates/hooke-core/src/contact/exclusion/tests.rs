@@ -308,3 +308,56 @@ fn a_slivers_corner_is_not_a_contact_of_the_triangle_beside_it() {
         assert!((0..2).all(|t| !skip.skips_triangle(v, t)));
     }
 }
+
+/// The watch on skipped pairs (`folds.rs`): a sheet flat, or rolled a quarter turn, has
+/// nothing through itself; the same sheet with one edge at a particle pushed through a
+/// triangle it skips (a crease tighter than the skipped pairs) is found.
+#[test]
+fn an_edge_pushed_through_a_skipped_triangle_is_found_and_a_rolled_sheet_is_not() {
+    let (n, s) = (8usize, 0.01);
+    let flat = |i: usize, j: usize| Vec3::new(i as f64 * s, 0.0, j as f64 * s);
+    let (model, x) = sheet(n, s / 4.0, |_, _| false, flat);
+    let prims = Prims::of(&model, x.len());
+    let skip = prims.exclusion(&x, 1.016 * s);
+    assert!(
+        skip.folds().len() > 100,
+        "{} pairs watched",
+        skip.folds().len()
+    );
+    assert_eq!(skip.folds().first_through(&x, &mut Vec::new()), None);
+    // Rolled about the x axis into a quarter of a cylinder 4 cm in radius.
+    let r = 0.04;
+    let rolled: Vec<Vec3> = x
+        .iter()
+        .map(|p| Vec3::new(p.x, r - r * (p.z / r).cos(), r * (p.z / r).sin()))
+        .collect();
+    assert_eq!(skip.folds().first_through(&rolled, &mut Vec::new()), None);
+    // A particle in the middle, a triangle it skips, and an edge at it whose other end
+    // and whose triangle share nothing with that triangle.
+    let v = (n / 2 * n + n / 2) as u32;
+    let tris = &prims.triangles;
+    let (t, w) = (0..tris.len() as u32)
+        .filter(|&t| skip.skips_triangle(v, t))
+        .find_map(|t| {
+            let far = |k: &u32| !tris[t as usize].contains(k);
+            tris.iter()
+                .filter(|a| a.contains(&v) && a.iter().all(far))
+                .flat_map(|a| a.iter().copied().filter(|&k| k != v))
+                .next()
+                .map(|w| (t, w))
+        })
+        .expect("a skipped triangle beside an edge at the middle particle");
+    let centre = tris[t as usize]
+        .iter()
+        .fold(Vec3::zeros(), |c, &k| c + x[k as usize] / 3.0);
+    let mut poked = x.clone();
+    poked[v as usize] = centre - Vec3::new(0.0, 0.2 * s, 0.0);
+    poked[w as usize] = centre + Vec3::new(0.0, 0.2 * s, 0.0);
+    // The edge passes through the triangle, and the flat sheet's edges beside them
+    // through the triangles at the two moved particles: some pair is found.
+    assert!(
+        skip.folds()
+            .first_through(&poked, &mut Vec::new())
+            .is_some()
+    );
+}

@@ -94,6 +94,13 @@ pub(crate) struct VbdBuffers {
     pub(crate) times: crate::integrator::SolveTimes,
 }
 
+impl VbdBuffers {
+    /// The pairs self-contact skips under block descent and Newton's step.
+    pub(crate) fn exclusion(&self) -> &crate::contact::exclusion::Exclusion {
+        self.detection.exclusion()
+    }
+}
+
 pub(in crate::integrator) fn step(
     model: &Model,
     p: &mut Particles,

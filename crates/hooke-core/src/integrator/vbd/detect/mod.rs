@@ -172,6 +172,11 @@ pub(in crate::integrator) enum Centres {
 }
 
 impl Detection {
+    /// The pairs the surfaces' own structure holds apart (empty before the first detection).
+    pub(in crate::integrator) fn exclusion(&self) -> &Exclusion {
+        &self.exclusion
+    }
+
     /// Particle `i`'s pairs.
     #[inline]
     pub(in crate::integrator) fn pairs_of(&self, i: usize) -> impl Iterator<Item = &Pair> {
