@@ -353,6 +353,10 @@ class BakeOperator:
         except KeyboardInterrupt:
             return self.cancelled()
         title = self.job.title
+        # What the run could not keep of its promises is said where the user looks, as the
+        # command line says it: a bake that finished is not a bake without a doubt.
+        for said in self.job.run.warnings():
+            self.report({"WARNING"}, f"{title}: hooke warns: {said}")
         if late:
             self.report({"WARNING"}, f"{title}: the interrupt came as the bake was put in place; it is kept")
         self.report({"INFO"}, f"{title}: baked {self.job.frames} frames")

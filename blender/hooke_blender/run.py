@@ -84,6 +84,13 @@ class Run:
                 self.process.wait()
         self.reader.join(timeout=1)
 
+    def warnings(self):
+        """What hooke warned of in a run that finished (a surface through a collider or
+        through itself, a setting it did not read, a mesh it converges on slowly), without
+        the leading ``warning: ``."""
+        self.reader.join(timeout=5)
+        return [line[len("warning: "):] for line in self.lines if line.startswith("warning: ")]
+
     def failure(self):
         """What hooke said when it failed: its error lines."""
         self.reader.join(timeout=5)

@@ -269,6 +269,24 @@ def test_bake_all_simulates_two_cloths_together_each_with_its_own_cache(fresh, c
         assert not os.path.exists(hooke_blender.cache_of(cloth))
 
 
+def test_what_hooke_warns_of_in_a_bake_that_finishes_is_reported(fresh, capfd):
+    """A cloth laid 2 mm above a cube's top at the first frame, nearer than its 5 mm
+    thickness, is moved out before the first step, and the run warns of it: the bake
+    finishes and plays, and Blender's report says what hooke said, naming the object."""
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 1, 3
+    cloth = grid("Cloth", 1.0, 6, (0.0, 0.0, 0.252))
+    cloth.hooke.kind = "CLOTH"
+    bpy.ops.mesh.primitive_cube_add(size=0.5, location=(0.0, 0.0, 0.0))
+    bpy.context.active_object.hooke.kind = "COLLIDER"
+    activate(cloth)
+    assert bpy.ops.hooke.bake() == {"FINISHED"}
+    said = capfd.readouterr()
+    text = said.out + said.err
+    assert "Object 'Cloth': hooke warns:" in text and "started inside collider" in text, text
+    assert_plays_hooke(cloth)
+
+
 def test_bad_settings_are_refused_naming_the_object_and_the_setting(fresh):
     scene = bpy.context.scene
     scene.frame_start, scene.frame_end = 1, 5
