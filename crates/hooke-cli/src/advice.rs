@@ -151,8 +151,9 @@ pub(crate) fn large_step_promises(scene: &Scene, integrator: Integrator) -> Vec<
             "{name} guarantees: no surface crosses another or itself at any dt (bodies with a \
              contact thickness: '{}'), but where a crease brings two points of one surface \
              that were within {:.1} mm of each other at rest, and near along it, to within its \
-             thickness (its own contacts there are skipped, docs/physics.md §4.1); bodies \
-             without one ({}) are not kept apart from each other",
+             thickness (its own contacts there are skipped, docs/physics.md §4.1; a run says \
+             so at each step where such a crease has crossed, §3.5); bodies without one ({}) \
+             are not kept apart from each other",
             surfaces.join("', '"),
             1e3 * model.self_contact_skip(),
             {
