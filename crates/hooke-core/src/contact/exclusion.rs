@@ -65,11 +65,12 @@ pub(crate) struct Exclusion {
 }
 
 /// The surfaces whose pairs an exclusion lists: their triangles and edges (indexed as the
-/// detection indexes them), and which particles lie on one.
+/// detection indexes them), and which particles lie on one that collides with itself (the
+/// pairs of one that does not are never contacts, so nothing of it is listed, nor watched).
 pub(crate) struct Surfaces<'a> {
     pub(crate) triangles: &'a [[u32; 3]],
     pub(crate) edges: &'a [[u32; 2]],
-    pub(crate) on_surface: &'a (dyn Fn(u32) -> bool + Sync),
+    pub(crate) self_colliding: &'a (dyn Fn(u32) -> bool + Sync),
     /// Whether any pair of them can touch (none when no surface collides with itself and
     /// there is only one): then nothing is listed.
     pub(crate) self_pairs: bool,
@@ -250,7 +251,7 @@ impl Exclusion {
             .map_init(
                 || Paths::new(n, surfaces.triangles.len()),
                 |paths, v| {
-                    if !(surfaces.on_surface)(v) || pinned(v) {
+                    if !(surfaces.self_colliding)(v) || pinned(v) {
                         return Vec::new();
                     }
                     paths.search(&adj, &[v], path);
@@ -285,7 +286,7 @@ impl Exclusion {
                 || Paths::new(n, surfaces.edges.len()),
                 |paths, e| {
                     let [a, b] = surfaces.edges[e];
-                    if pinned(a) || pinned(b) {
+                    if !(surfaces.self_colliding)(a) || pinned(a) || pinned(b) {
                         return Vec::new();
                     }
                     paths.search(&adj, &[a, b], path);

@@ -191,7 +191,10 @@ impl ContactState {
         let surfaces = Surfaces {
             triangles: &self.tris,
             edges: &self.edges,
-            on_surface: &|v| surface_of[v as usize] != NONE,
+            self_colliding: &|v| {
+                let k = surface_of[v as usize];
+                k != NONE && model.surfaces[k as usize].self_collision
+            },
             self_pairs: model.surfaces_touch(),
         };
         let (radius, pinned) = (2.0 * self.h_max, |i| p.is_pinned(i as usize));

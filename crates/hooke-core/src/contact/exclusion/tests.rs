@@ -82,7 +82,7 @@ impl Prims {
         let surfaces = Surfaces {
             triangles: &self.triangles,
             edges: &self.edges,
-            on_surface: &on,
+            self_colliding: &on,
             self_pairs: true,
         };
         Exclusion::new(&surfaces, x, (radius, radius), &|_| false)

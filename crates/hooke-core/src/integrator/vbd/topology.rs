@@ -18,6 +18,8 @@ pub(in crate::integrator) struct Topology {
     pub(in crate::integrator) surface: Vec<u16>,
     /// Whether any surface pair (self or between bodies) can touch.
     pub(in crate::integrator) self_pairs: bool,
+    /// Per surface of the model: whether it collides with itself.
+    self_collision: Vec<bool>,
     /// The thickness particles outside every active surface keep from velocity-level
     /// colliders ([`Model::point_thickness`]).
     pub(in crate::integrator) point: f64,
@@ -71,6 +73,7 @@ impl Topology {
             t.edges.extend(s.edges().into_iter().map(|e| (e, k as u16)));
         }
         t.self_pairs = model.surfaces_touch();
+        t.self_collision = model.surfaces.iter().map(|s| s.self_collision).collect();
         let mut edges = std::collections::HashSet::new();
         let mut corners = vec![false; n];
         t.owns = t
@@ -110,7 +113,10 @@ impl Topology {
         let surfaces = Surfaces {
             triangles: &triangles,
             edges: &edges,
-            on_surface: &|v| self.surface[v as usize] != u16::MAX,
+            self_colliding: &|v| {
+                let k = self.surface[v as usize];
+                k != u16::MAX && self.self_collision[k as usize]
+            },
             self_pairs: self.self_pairs,
         };
         Exclusion::new(&surfaces, rest, (radius, near), pinned)
