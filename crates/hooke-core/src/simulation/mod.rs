@@ -454,7 +454,8 @@ impl Simulation {
     }
 
     /// The notices of steps since the last call: each the first of its kind for its
-    /// collider (see [`Notice`]). A run shows them as they come.
+    /// collider, or for its surface through itself (see [`Notice`]). A run shows them as
+    /// they come.
     pub fn take_notices(&mut self) -> Vec<Notice> {
         self.notices.take()
     }
