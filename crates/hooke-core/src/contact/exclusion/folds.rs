@@ -5,7 +5,8 @@
 //!
 //! A surface leaves a state without crossings through a crossing only by a particle
 //! passing through a triangle or an edge through an edge; a pair that is measured never
-//! does (the bounds, or the contact phase, keep it apart). What may is a skipped pair: a
+//! does (the large steps' bounds keep it apart, and the contact phase at steps within half
+//! the thickness: docs/physics.md §3.5). What may is a skipped pair: a
 //! particle `v` through a skipped triangle `t`, after which an edge at `v` passes through
 //! `t`, or an edge `e` through a skipped edge `f`, after which one of them passes through
 //! a triangle of the other. So the pairs watched are each skipped triangle against the
