@@ -187,6 +187,15 @@ response = {{ kind = "restitution", cr = 0.0, friction = 0.5 }}
     crate::meshes::build(&text, &dir).unwrap()
 }
 
+/// Each face of `faces` (triangles) at positions `x`, with its corners, as the crossing
+/// checker takes them.
+fn triangles_at(faces: &[Vec<u32>], x: &[hooke_core::Vec3]) -> Vec<(Tri, [u32; 3])> {
+    faces
+        .iter()
+        .map(|f| ([0, 1, 2].map(|k| x[f[k] as usize]), [f[0], f[1], f[2]]))
+        .collect()
+}
+
 /// What [`step_watching_folds`] saw: the independent checker's crossings after each step,
 /// split by whether the pair is one self-contact skips, and what the run said.
 pub(crate) struct Folds {
@@ -243,10 +252,7 @@ pub(crate) fn step_watching_folds(scene: &mut Scene, mut each: impl FnMut(&Scene
         scene.simulation.step().unwrap();
         each(scene);
         let x = &scene.simulation.particles().x;
-        let cloth: Vec<(Tri, [u32; 3])> = faces
-            .iter()
-            .map(|f| ([0, 1, 2].map(|k| x[f[k] as usize]), [f[0], f[1], f[2]]))
-            .collect();
+        let cloth = triangles_at(&faces, x);
         let mut here = 0;
         for (a, b) in cloth_pairs(&cloth) {
             if apart(&faces[a], &faces[b]) <= reach * (1.0 + 1e-9) {
@@ -319,10 +325,7 @@ response = { kind = "restitution", cr = 0.0, friction = 0.5 }
     for _ in 0..scene.steps {
         scene.simulation.step().unwrap();
         let x = &scene.simulation.particles().x;
-        let cloth: Vec<(Tri, [u32; 3])> = faces
-            .iter()
-            .map(|f| ([0, 1, 2].map(|k| x[f[k] as usize]), [f[0], f[1], f[2]]))
-            .collect();
+        let cloth = triangles_at(&faces, x);
         crossed += usize::from(!cloth_pairs(&cloth).is_empty());
     }
     assert!(

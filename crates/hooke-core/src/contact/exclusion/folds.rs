@@ -14,7 +14,7 @@
 //! other, sharing no particle. Nothing else is looked at, so a surface with nothing
 //! skipped costs nothing.
 
-use super::list;
+use super::{list, listed};
 use crate::particles::Vec3;
 use rayon::prelude::*;
 
@@ -59,11 +59,7 @@ impl Folds {
             return Self::default();
         }
         let pair = |a: u32, b: u32| [a.min(b), a.max(b)];
-        let skips = |v: u32, t: u32| {
-            list(skipped.triangle_start, skipped.triangles, v as usize)
-                .binary_search(&t)
-                .is_ok()
-        };
+        let skips = |v: u32, t: u32| listed(skipped.triangle_start, skipped.triangles, v, t);
         // Each pair once from each side that lists it, from the first corner that does
         // (a triangle's three corners often skip the same triangle): the list before its
         // sort holds at most twice the pairs.
