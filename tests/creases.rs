@@ -335,3 +335,75 @@ response = { kind = "restitution", cr = 0.0, friction = 0.5 }
     let said: Vec<_> = scene.simulation.notice_tally().to_vec();
     assert!(said.is_empty(), "{said:?}");
 }
+
+/// Whether two triangles the checker finds crossed lie in one plane to rounding (every
+/// corner of each within 1e-9 m of the other's plane): a sheet still flat, not a crossing.
+fn flat(a: &Tri, b: &Tri) -> bool {
+    let near = |t: &Tri, of: &Tri| {
+        let n = (of[1] - of[0]).cross(&(of[2] - of[0])).normalize();
+        t.iter().all(|p| n.dot(&(p - of[0])).abs() <= 1e-9)
+    };
+    near(a, b) || near(b, a)
+}
+
+/// Implicit Euler resolves contacts after its step, and at 4 ms on the cloth pile (where
+/// `hooke check` asks for under 0.47 ms) a step can close two layers by more than their
+/// 5 mm thickness: the pile folds through itself. The run says so at every step after
+/// which the checker independent of the solver finds a pair crossed that was not before,
+/// the first said at the first such step, and at no step after which nothing crosses
+/// (docs/physics.md §3.5, "Layers after a large step").
+#[test]
+fn layers_that_a_large_implicit_step_lets_through_each_other_are_said_at_the_step() {
+    let overrides = hooke_scene::Overrides {
+        integrator: Some(hooke_core::Integrator::Implicit),
+        dt: Some(0.004),
+        duration: Some(1.0),
+        ..Default::default()
+    };
+    let mut scene = crate::common::builtin("cloth-pile", &overrides);
+    let faces = scene.bodies[0].faces();
+    let said = |scene: &Scene| -> u64 {
+        let tally = scene.simulation.notice_tally();
+        tally
+            .iter()
+            .filter(|(n, _)| matches!(n.cause, hooke_core::Cause::Layers { .. }))
+            .map(|(_, steps)| *steps)
+            .sum()
+    };
+    let (mut before, mut first, mut disagree) = (Vec::new(), None, Vec::new());
+    for step in 1..=scene.steps {
+        let told_before = said(&scene);
+        scene.simulation.step().unwrap();
+        let cloth = triangles_at(&faces, &scene.simulation.particles().x);
+        let now: Vec<_> = cloth_pairs(&cloth)
+            .into_iter()
+            .filter(|&(a, b)| !flat(&cloth[a].0, &cloth[b].0))
+            .collect();
+        let fresh = now.iter().filter(|p| !before.contains(*p)).count();
+        let told = said(&scene) > told_before;
+        if fresh > 0 {
+            first.get_or_insert(step);
+        }
+        if (fresh > 0 && !told) || (told && now.is_empty()) {
+            disagree.push(format!(
+                "step {step}: {fresh} pairs newly crossed ({} in all), and the run {} so",
+                now.len(),
+                if told { "said" } else { "did not say" }
+            ));
+        }
+        before = now;
+    }
+    assert!(disagree.is_empty(), "{}", disagree.join("\n"));
+    let first = first.expect("the pile folds through itself at 4 ms steps");
+    let tally = scene.simulation.notice_tally();
+    let (notice, _) = tally
+        .iter()
+        .find(|(n, _)| matches!(n.cause, hooke_core::Cause::Layers { .. }))
+        .unwrap();
+    assert_eq!(notice.step, first, "said at the first step that crossed");
+    assert_eq!(notice.through, Through::Itself(0));
+    eprintln!(
+        "first crossed at step {first}; said on {} steps",
+        said(&scene)
+    );
+}

@@ -205,8 +205,9 @@ pub(crate) fn thin_surfaces(scene: &Scene) -> Vec<String> {
         .map(|b| {
             format!(
                 "body '{}': two layers closing at {:.2} m/s move {:.1} mm per step of {} s, more \
-                 than its contact thickness of {:.1} mm, so they can cross unseen; use dt below \
-                 {:.3e} s or a larger thickness",
+                 than its contact thickness of {:.1} mm, so they can cross between two looks of the \
+                 contacts (the run says so at a step where they did); use dt below {:.3e} s or a \
+                 larger thickness",
                 b.name,
                 2.0 * speed,
                 2.0 * speed * dt * 1e3,

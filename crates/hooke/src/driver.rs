@@ -32,7 +32,7 @@ fn tally_notices(scene: &Scene) {
     for (n, steps) in scene.simulation.notice_tally() {
         if *steps > 1 {
             let why = match n.cause {
-                Cause::LargeStep { integrator, .. } => {
+                Cause::LargeStep { integrator, .. } | Cause::Layers { integrator, .. } => {
                     format!("{integrator}'s steps moved it farther than its contacts can follow")
                 }
                 Cause::Pinned => "a pinned particle lay in the collider's path".to_string(),
@@ -63,6 +63,10 @@ fn through(scene: &Scene, through: hooke_core::Through) -> String {
             scene.simulation.model().colliders[k].shape.name()
         ),
         hooke_core::Through::Itself(_) => "itself".to_string(),
+        hooke_core::Through::Surfaces(_, k) => format!(
+            "the surface of body {}",
+            body_of(scene, scene.simulation.model().surfaces[k].particles.start)
+        ),
     }
 }
 
@@ -80,9 +84,12 @@ fn body_of(scene: &Scene, particle: usize) -> String {
 
 /// One notice as a sentence: when, which body through which collider (or itself), and why.
 pub fn describe(scene: &Scene, n: &hooke_core::Notice) -> String {
-    let promise = match n.through {
-        hooke_core::Through::Collider(_) => "which the run promised not to let happen",
-        hooke_core::Through::Itself(_) => "which self-contact does not keep out there",
+    let promise = match (n.through, n.cause) {
+        (_, hooke_core::Cause::Crease { .. }) => "which self-contact does not keep out there",
+        (_, hooke_core::Cause::Layers { .. }) => {
+            "which contacts after so large a step do not keep out"
+        }
+        _ => "which the run promised not to let happen",
     };
     format!(
         "step {} (t = {} s): a surface of body {} (particle {}) ended the step through {}, \

@@ -40,7 +40,7 @@ use super::proximity::{point_triangle_distance, segment_distance};
 use crate::model::Model;
 use crate::particles::Vec3;
 use folds::Skipped;
-pub(crate) use folds::{Folds, Plane};
+pub(crate) use folds::{Folds, Plane, through};
 use rayon::prelude::*;
 
 /// At most this many particles reached by one search along the edges.

@@ -5,6 +5,7 @@
 //! unless contacts moved particles after it.
 
 pub(crate) mod divergence;
+mod layers;
 pub(crate) mod notice;
 pub(crate) mod renumber;
 pub(crate) mod runaway;
@@ -22,6 +23,7 @@ use crate::model::{Attachment, Model};
 use crate::parallel;
 use crate::particles::{Particles, Vec3};
 use divergence::{Divergence, StepEnd};
+use layers::LayerWatch;
 use notice::{Cause, Notice, Notices, Through};
 use renumber::Renumbering;
 use runaway::EnergyWatch;
@@ -61,8 +63,10 @@ pub struct Simulation {
     /// The state the run started from, for the stable-step estimate a divergence names
     /// (the one `hooke check` gives).
     initial: Particles,
-    /// The crossing watch ([`watch`]) and what it found.
+    /// The crossing watch ([`watch`]), the watch on layers after a large step
+    /// ([`layers`]), and what they found.
     crossings: CrossingWatch,
+    layers: LayerWatch,
     notices: Notices,
 }
 
@@ -118,6 +122,7 @@ impl Simulation {
             },
             inline,
             crossings: CrossingWatch::default(),
+            layers: LayerWatch::default(),
             notices: Notices::default(),
         }
     }
@@ -249,6 +254,9 @@ impl Simulation {
         self.workspace
             .ensure(&self.model, self.particles.len(), self.integrator);
         self.contacts = ContactState::new(self.particles.len());
+        // The watches list the surfaces' particles by number.
+        self.crossings = CrossingWatch::default();
+        self.layers = LayerWatch::default();
         self.watch.renumbered();
         self.last = StepReport {
             saved_start: false,
@@ -337,6 +345,7 @@ impl Simulation {
         self.step += 1;
         self.end_pins(time + self.dt);
         self.watch_crossings(time, report);
+        self.watch_layers(report);
         self.watch_folds();
         divergence::check(StepEnd {
             model: &self.model,
@@ -416,6 +425,49 @@ impl Simulation {
             through: Through::Collider(collider),
             particle: *pinned.unwrap_or(&ids[0]) as usize,
             cause,
+        });
+    }
+
+    /// The watch on layers after a large step ([`layers`], docs/physics.md §3.5): a
+    /// surface found through itself or another after a step of an integrator whose contacts
+    /// come after it, and that moved a surface particle relative to the others more than
+    /// they can follow, is recorded as a [`Notice`].
+    fn watch_layers(&mut self, report: StepReport) {
+        if self.integrator.solves_contacts() || !self.layers.watches(&self.model) {
+            return;
+        }
+        let Some(start) = self.workspace.start_positions(report) else {
+            return;
+        };
+        let moved = self.layers.relative_move(start, &self.particles.x);
+        let thickness = self.layers.thickness;
+        if moved <= 0.5 * thickness {
+            return;
+        }
+        let folds = self.contacts.exclusion().folds();
+        let Some(found) = self.layers.first_through(&self.particles.x, folds) else {
+            return;
+        };
+        let [a, b] = found.surfaces;
+        // Two surfaces are named lower first, so that either passing through the other is
+        // one kind of notice; the particle is on the first.
+        let (through, particle) = if a == b {
+            (Through::Itself(a), found.corners[0][0])
+        } else if a < b {
+            (Through::Surfaces(a, b), found.corners[0][0])
+        } else {
+            (Through::Surfaces(b, a), found.corners[1][0])
+        };
+        self.notices.record(Notice {
+            step: self.step,
+            time: self.time(),
+            through,
+            particle: particle as usize,
+            cause: Cause::Layers {
+                integrator: self.integrator,
+                moved,
+                thickness,
+            },
         });
     }
 

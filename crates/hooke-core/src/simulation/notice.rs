@@ -1,15 +1,16 @@
 //! What a step could not keep of the project's promises, said at the step where it happened
-//! (docs/physics.md §3.5): a surface that ended a step through a collider, or through
-//! itself where self-contact skips. The simulation keeps the first notice of each kind for
-//! each collider and each surface and counts the steps of the rest, so a long run says it
-//! once, when it begins, and how often at its end.
+//! (docs/physics.md §3.5): a surface that ended a step through a collider, through itself
+//! where self-contact skips, or through itself or another surface after an explicit step
+//! too large for its contacts. The simulation keeps the first notice of each kind for each
+//! collider and each surface and counts the steps of the rest, so a long run says it once,
+//! when it begins, and how often at its end.
 
 use crate::integrator::Integrator;
 use crate::number::Approx;
 use std::fmt;
 
-/// A surface (a cloth's edge or triangle) that passes through a collider, or through
-/// itself, after a step.
+/// A surface (a cloth's edge or triangle) that passes through a collider, through itself
+/// or through another surface, after a step.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Notice {
     /// The step after which it was found (1 for the first step).
@@ -33,9 +34,12 @@ pub enum Through {
     /// The surface itself (its index among the model's surfaces): one of its triangles
     /// through another of it.
     Itself(usize),
+    /// Two surfaces through each other (their indices among the model's surfaces, lower
+    /// first): [`Notice::particle`] is on the first.
+    Surfaces(usize, usize),
 }
 
-/// Why a step left a surface through a collider.
+/// Why a step left a surface through a collider or a surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Cause {
     /// The integrator's contacts come after its step (every integrator but block descent),
@@ -69,6 +73,19 @@ pub enum Cause {
         /// The integrator that took the step.
         integrator: Integrator,
     },
+    /// The integrator's contacts come after its step, and the step moved a surface particle
+    /// `moved` metres relative to the surfaces' shared motion, more than half the thinnest
+    /// thickness of surfaces that touch, `thickness`: two layers can close by more than
+    /// the thickness, and pass through each other, between two looks.
+    Layers {
+        /// The integrator that took the step.
+        integrator: Integrator,
+        /// The step's largest move of a surface particle relative to the surfaces' mean
+        /// move, metres.
+        moved: f64,
+        /// The thinnest contact thickness of the surfaces that touch, metres.
+        thickness: f64,
+    },
 }
 
 impl Cause {
@@ -79,6 +96,7 @@ impl Cause {
             Self::Pinned => 1,
             Self::Squeezed { .. } => 2,
             Self::Crease { .. } => 3,
+            Self::Layers { .. } => 4,
         }
     }
 }
@@ -122,6 +140,21 @@ impl fmt::Display for Cause {
                  skipped pairs ({} times it), so that the crease is kept open",
                 Approx(reach * 1e3),
                 if integrator.solves_contacts() { 4 } else { 2 },
+            ),
+            Self::Layers {
+                integrator,
+                moved,
+                thickness,
+            } => write!(
+                f,
+                "{integrator} resolves contacts after its step, and this step moved a surface \
+                 particle {} mm relative to the surfaces' shared motion, more than half the \
+                 contact thickness of {} mm, so two layers can close by more than the \
+                 thickness and pass through each other between two looks; take a smaller dt \
+                 (hooke check says which), or `--integrator vbd`, whose steps keep surfaces \
+                 apart at any dt",
+                Approx(moved * 1e3),
+                Approx(thickness * 1e3),
             ),
         }
     }

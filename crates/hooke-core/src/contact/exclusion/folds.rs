@@ -131,12 +131,14 @@ impl Folds {
             .with_min_len(CHUNK)
             .find_map_first(|&[a, b]| {
                 let (ta, tb) = (&self.triangles[a as usize], &self.triangles[b as usize]);
-                let (pa, pb) = (&planes[a as usize], &planes[b as usize]);
-                // An edge passes through a triangle only if its ends lie on either side of
-                // the triangle's plane: three products reject most pairs of a smooth sheet.
-                let (sa, sb) = (pb.sides(ta, x), pa.sides(tb, x));
-                passes(ta, (tb, pb), sa, x).or_else(|| passes(tb, (ta, pa), sb, x))
+                through((ta, &planes[a as usize]), (tb, &planes[b as usize]), x)
             })
+    }
+
+    /// Whether triangles `a` and `b` (as the exclusion indexes them) are a watched pair:
+    /// one that only a skipped pair could bring through each other.
+    pub(crate) fn watches(&self, a: u32, b: u32) -> bool {
+        self.pairs.binary_search(&[a.min(b), a.max(b)]).is_ok()
     }
 
     /// How many triangle pairs are watched.
@@ -156,7 +158,7 @@ pub(crate) struct Plane {
 
 impl Plane {
     /// The plane of triangle `t` at `x`.
-    fn of(t: &[u32; 3], x: &[Vec3]) -> Self {
+    pub(crate) fn of(t: &[u32; 3], x: &[Vec3]) -> Self {
         let [p, q, r] = t.map(|i| x[i as usize]);
         let n = (q - p).cross(&(r - p));
         let normal = n / n.norm();
@@ -170,6 +172,19 @@ impl Plane {
     fn sides(&self, t: &[u32; 3], x: &[Vec3]) -> [f64; 3] {
         t.map(|i| self.normal.dot(&x[i as usize]) - self.offset)
     }
+}
+
+/// Whether an edge of one triangle passes through the other, each given with its plane
+/// at `x`: the corners of the triangle whose edge passes, that edge's two first.
+pub(crate) fn through(
+    (ta, pa): (&[u32; 3], &Plane),
+    (tb, pb): (&[u32; 3], &Plane),
+    x: &[Vec3],
+) -> Option<[u32; 3]> {
+    // An edge passes through a triangle only if its ends lie on either side of the
+    // triangle's plane: three products reject most pairs of a smooth sheet.
+    let (sa, sb) = (pb.sides(ta, x), pa.sides(tb, x));
+    passes(ta, (tb, pb), sa, x).or_else(|| passes(tb, (ta, pa), sb, x))
 }
 
 /// Whether an edge of triangle `a`, its corners at distances `side` from `b`'s plane,
