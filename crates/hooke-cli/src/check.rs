@@ -112,7 +112,8 @@ pub fn check(arg: &str, setup: &SetupArgs) -> Result<ExitCode> {
              conjugate gradients to 1e-8); not a solved nonlinear step, nor contacts inside \
              the solve: the contact phase after the step does as for the explicit schemes, \
              so a step that moves a particle farther than the tunnelling limits below can \
-             leave a surface through a collider (the run warns at the first step that does)"
+             leave a surface through a collider, itself or another surface (the run warns at \
+             the first step that does)"
         );
     }
     // These concern the scene's own integrator, whose contacts come after its step; the
