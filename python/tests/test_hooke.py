@@ -152,34 +152,32 @@ def test_scene_keys_change_the_physics():
     assert hooke.metrics.mean_height(soft) < hooke.metrics.mean_height(stiff) - 0.01
 
 
-def test_a_surface_through_a_collider_is_a_runtime_warning():
-    # Implicit Euler at 1/60 s lets the cloth through the round table (its contacts come
-    # after a step that moves the cloth centimetres); the run says so, once, naming both.
+def runtime_warnings(sim):
+    """Runs `sim` to its end and gives the texts of the RuntimeWarnings it raised."""
     import warnings
 
-    sim = hooke.load("cloth-table", integrator="implicit", dt=1 / 60, duration=1.0)
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         sim.run()
-    crossings = [w for w in said if issubclass(w.category, RuntimeWarning)]
-    assert len(crossings) == 1, [str(w.message) for w in said]
-    text = str(crossings[0].message)
-    assert "body 'cloth'" in text and "collider[1]" in text and "implicit" in text
+    return [str(w.message) for w in said if issubclass(w.category, RuntimeWarning)]
+
+
+def test_a_surface_through_a_collider_is_a_runtime_warning():
+    # Implicit Euler at 1/60 s lets the cloth through the round table (its contacts come
+    # after a step that moves the cloth centimetres); the run says so, once, naming both.
+    said = runtime_warnings(hooke.load("cloth-table", integrator="implicit", dt=1 / 60,
+                                       duration=1.0))
+    assert len(said) == 1, said
+    assert "body 'cloth'" in said[0] and "collider[1]" in said[0] and "implicit" in said[0]
 
 
 def test_layers_a_large_step_lets_through_each_other_are_a_runtime_warning():
     # Implicit Euler at 4 ms folds the pile through itself (hooke check asks for under
     # 0.47 ms): said once, at the step the independent checker first finds it, 180.
-    import warnings
-
-    sim = hooke.load("cloth-pile", integrator="implicit", dt=0.004, duration=1.0)
-    with warnings.catch_warnings(record=True) as said:
-        warnings.simplefilter("always")
-        sim.run()
-    crossings = [w for w in said if issubclass(w.category, RuntimeWarning)]
-    assert len(crossings) == 1, [str(w.message) for w in said]
-    text = str(crossings[0].message)
-    assert text.startswith("step 180 ") and "through itself" in text, text
+    said = runtime_warnings(hooke.load("cloth-pile", integrator="implicit", dt=0.004,
+                                       duration=1.0))
+    assert len(said) == 1, said
+    assert said[0].startswith("step 180 ") and "through itself" in said[0], said[0]
 
 
 def test_a_material_is_read_set_and_written_back(tmp_path):
