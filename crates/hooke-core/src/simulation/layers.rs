@@ -88,11 +88,11 @@ impl LayerWatch {
             .reduce(|| 0.0, f64::max)
     }
 
-    /// The first triangle (in the surfaces' order, so the same on any thread count) of
-    /// which an edge passes through a triangle of a surface it touches, or that a
-    /// triangle's edge passes through, at `x`; pairs sharing a particle, and those `folds`
-    /// watches, are left out.
-    pub(crate) fn first_through(&mut self, x: &[Vec3], folds: &Folds) -> Option<Crossing> {
+    /// For each pair of surfaces that touch (a surface and itself included), the first
+    /// triangle pair of them (by the lower triangle in the surfaces' order, so the same on
+    /// any thread count) of which an edge of one passes through the other at `x`; pairs
+    /// sharing a particle, and those `folds` watches, are left out.
+    pub(crate) fn crossings(&mut self, x: &[Vec3], folds: &Folds) -> Vec<Crossing> {
         let triangles = &self.triangles;
         triangles
             .par_iter()
@@ -116,26 +116,28 @@ impl LayerWatch {
             .fold(0.0, f64::max);
         if !(cell.is_finite() && cell > 0.0) {
             // Positions beyond numbers are the divergence check's to say.
-            return None;
+            return Vec::new();
         }
         self.grid.build(cell, self.boxes.iter().map(|b| b.0));
         let (planes, boxes, grid) = (&self.planes, &self.boxes, &self.grid);
         let (surface, self_collision) = (&self.surface, &self.self_collision);
         let touch =
             |i: usize, j: usize| surface[i] != surface[j] || self_collision[surface[i] as usize];
-        (0..triangles.len())
+        // Every pair is looked at (a look that finds nothing, the usual one, does so
+        // anyway), so that each pair of surfaces is said at every step it crossed.
+        let found: Vec<(usize, usize, [u32; 3])> = (0..triangles.len())
             .into_par_iter()
             .with_min_len(CHUNK)
-            .find_map_first(|i| {
+            .flat_map_iter(|i| {
                 let ta = &triangles[i];
                 let [cx, cy, cz] = grid.cell_of(&boxes[i].0);
-                let mut found = None;
+                let mut found = Vec::new();
                 for dx in -1..=1 {
                     for dy in -1..=1 {
                         for dz in -1..=1 {
                             grid.visit([cx + dx, cy + dy, cz + dz], |j| {
                                 let j = j as usize;
-                                if found.is_some() || j <= i || !overlap(&boxes[i], &boxes[j]) {
+                                if j <= i || !overlap(&boxes[i], &boxes[j]) {
                                     return;
                                 }
                                 let tb = &triangles[j];
@@ -145,26 +147,42 @@ impl LayerWatch {
                                 {
                                     return;
                                 }
-                                found = through((ta, &planes[i]), (tb, &planes[j]), x)
-                                    .map(|corners| (j, corners));
+                                if let Some(corners) =
+                                    through((ta, &planes[i]), (tb, &planes[j]), x)
+                                {
+                                    found.push((i, j, corners));
+                                }
                             });
                         }
                     }
                 }
-                let (j, corners) = found?;
-                let (si, sj) = (surface[i] as usize, surface[j] as usize);
-                Some(if ta.contains(&corners[0]) {
-                    Crossing {
-                        surfaces: [si, sj],
-                        corners: [corners, triangles[j]],
-                    }
-                } else {
-                    Crossing {
-                        surfaces: [sj, si],
-                        corners: [corners, *ta],
-                    }
-                })
+                found
             })
+            .collect();
+        // The first crossing of each pair of surfaces, in the order found: by the lower
+        // triangle, then the grid's order, the same on any thread count.
+        let mut first: Vec<Crossing> = Vec::new();
+        for (i, j, corners) in found {
+            let (si, sj) = (surface[i] as usize, surface[j] as usize);
+            if first
+                .iter()
+                .any(|c| c.surfaces == [si, sj] || c.surfaces == [sj, si])
+            {
+                continue;
+            }
+            first.push(if triangles[i].contains(&corners[0]) {
+                Crossing {
+                    surfaces: [si, sj],
+                    corners: [corners, triangles[j]],
+                }
+            } else {
+                Crossing {
+                    surfaces: [sj, si],
+                    corners: [corners, triangles[i]],
+                }
+            });
+        }
+        first
     }
 }
 
@@ -209,9 +227,39 @@ mod tests {
     #[test]
     fn an_edge_through_another_surface_is_found_with_both_surfaces() {
         let mut w = watch(&[([0, 1, 2], 0), ([3, 4, 5], 1)], &[false, false]);
-        let found = w.first_through(&positions(), &Folds::default()).unwrap();
-        assert_eq!(found.surfaces, [1, 0], "the upright triangle's edge passes");
-        assert_eq!(found.corners, [[3, 4, 5], [0, 1, 2]]);
+        let found = w.crossings(&positions(), &Folds::default());
+        assert_eq!(found.len(), 1);
+        assert_eq!(
+            found[0].surfaces,
+            [1, 0],
+            "the upright triangle's edge passes"
+        );
+        assert_eq!(found[0].corners, [[3, 4, 5], [0, 1, 2]]);
+    }
+
+    #[test]
+    fn each_pair_of_surfaces_crossed_is_found_once() {
+        // The upright triangle (surface 1) passes through the flat one (surface 0); a
+        // copy of it beside (surface 2, particles 5–7 moved onto it) passes through it
+        // too, and a second flat triangle of surface 0 under both adds no pair.
+        let mut x = positions();
+        x[6] = x[3] + Vec3::new(0.01, 0.0, 0.0);
+        x[7] = x[4] + Vec3::new(0.01, 0.0, 0.0);
+        x.push(x[5] + Vec3::new(0.01, 0.0, 0.0));
+        x.extend([
+            Vec3::new(-1.0, 0.0, -1.1),
+            Vec3::new(1.0, 0.0, -1.1),
+            Vec3::new(0.0, 0.0, 0.9),
+        ]);
+        let tris = [
+            ([0, 1, 2], 0),
+            ([3, 4, 5], 1),
+            ([6, 7, 8], 2),
+            ([9, 10, 11], 0),
+        ];
+        let found = watch(&tris, &[false, false, false]).crossings(&x, &Folds::default());
+        let pairs: Vec<_> = found.iter().map(|c| c.surfaces).collect();
+        assert_eq!(pairs, [[1, 0], [2, 0]]);
     }
 
     #[test]
@@ -220,13 +268,12 @@ mod tests {
         let x = positions();
         assert!(
             watch(&tris, &[false])
-                .first_through(&x, &Folds::default())
-                .is_none()
+                .crossings(&x, &Folds::default())
+                .is_empty()
         );
-        let found = watch(&tris, &[true])
-            .first_through(&x, &Folds::default())
-            .unwrap();
-        assert_eq!(found.surfaces, [0, 0]);
+        let found = watch(&tris, &[true]).crossings(&x, &Folds::default());
+        assert_eq!(found.len(), 1);
+        assert_eq!(found[0].surfaces, [0, 0]);
     }
 
     #[test]
@@ -239,8 +286,8 @@ mod tests {
         }
         assert!(
             watch(&tris, &[true])
-                .first_through(&x, &Folds::default())
-                .is_none()
+                .crossings(&x, &Folds::default())
+                .is_empty()
         );
     }
 

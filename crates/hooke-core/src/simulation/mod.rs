@@ -445,30 +445,29 @@ impl Simulation {
             return;
         }
         let folds = self.contacts.exclusion().folds();
-        let Some(found) = self.layers.first_through(&self.particles.x, folds) else {
-            return;
-        };
-        let [a, b] = found.surfaces;
-        // Two surfaces are named lower first, so that either passing through the other is
-        // one kind of notice; the particle is on the first.
-        let (through, particle) = if a == b {
-            (Through::Itself(a), found.corners[0][0])
-        } else if a < b {
-            (Through::Surfaces(a, b), found.corners[0][0])
-        } else {
-            (Through::Surfaces(b, a), found.corners[1][0])
-        };
-        self.notices.record(Notice {
-            step: self.step,
-            time: self.time(),
-            through,
-            particle: particle as usize,
-            cause: Cause::Layers {
-                integrator: self.integrator,
-                moved,
-                thickness,
-            },
-        });
+        for found in self.layers.crossings(&self.particles.x, folds) {
+            let [a, b] = found.surfaces;
+            // Two surfaces are named lower first, so that either passing through the other
+            // is one kind of notice; the particle is on the first.
+            let (through, particle) = if a == b {
+                (Through::Itself(a), found.corners[0][0])
+            } else if a < b {
+                (Through::Surfaces(a, b), found.corners[0][0])
+            } else {
+                (Through::Surfaces(b, a), found.corners[1][0])
+            };
+            self.notices.record(Notice {
+                step: self.step,
+                time: self.time(),
+                through,
+                particle: particle as usize,
+                cause: Cause::Layers {
+                    integrator: self.integrator,
+                    moved,
+                    thickness,
+                },
+            });
+        }
     }
 
     /// The watch on what self-contact skips (docs/physics.md §3.5): a surface found through
