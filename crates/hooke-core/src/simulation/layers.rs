@@ -55,7 +55,7 @@ impl LayerWatch {
             return;
         }
         self.self_collision = model.surfaces.iter().map(|s| s.self_collision).collect();
-        // In the contact phase's order (`contact::Contacts::prepare`), so that a triangle's
+        // In the contact phase's order (`contact::ContactState::prepare`), so that a triangle's
         // index is the exclusion's.
         for (k, s) in model.active_surfaces() {
             self.triangles.extend_from_slice(&s.triangles);
