@@ -13,27 +13,16 @@
 
 use crate::contact::exclusion::{Folds, Plane, through};
 use crate::contact::grid::Grid;
-use crate::model::Model;
 use crate::particles::Vec3;
 use rayon::prelude::*;
 
 /// Triangles per parallel chunk.
 const CHUNK: usize = 256;
 
-/// The surfaces that touch, their triangles indexed as the contact phase's exclusion
-/// indexes them, built once per model, and the buffers of a look.
+/// The buffers of a look; the surfaces' triangles are the crossing watch's
+/// (`simulation::watch::CrossingWatch`).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct LayerWatch {
-    built: bool,
-    triangles: Vec<[u32; 3]>,
-    /// Each triangle's surface (its index among the model's surfaces).
-    surface: Vec<u32>,
-    /// Per surface of the model: whether it collides with itself.
-    self_collision: Vec<bool>,
-    /// The surfaces' particles, for the step's move.
-    particles: Vec<u32>,
-    /// The thinnest thickness of the surfaces that touch (infinite without any).
-    pub(crate) thickness: f64,
     planes: Vec<Plane>,
     boxes: Vec<(Vec3, Vec3)>,
     grid: Grid,
@@ -48,52 +37,17 @@ pub(crate) struct Crossing {
 }
 
 impl LayerWatch {
-    fn build(&mut self, model: &Model) {
-        self.built = true;
-        self.thickness = f64::INFINITY;
-        if !model.surfaces_touch() {
-            return;
-        }
-        self.self_collision = model.surfaces.iter().map(|s| s.self_collision).collect();
-        // In the contact phase's order (`contact::ContactState::prepare`), so that a triangle's
-        // index is the exclusion's.
-        for (k, s) in model.active_surfaces() {
-            self.triangles.extend_from_slice(&s.triangles);
-            self.surface
-                .extend(std::iter::repeat_n(k as u32, s.triangles.len()));
-            self.particles.extend(s.particles.clone().map(|i| i as u32));
-            self.thickness = self.thickness.min(s.thickness);
-        }
-    }
-
-    /// Whether the model has surfaces that can touch, with triangles to pass through.
-    pub(crate) fn watches(&mut self, model: &Model) -> bool {
-        if !self.built {
-            self.build(model);
-        }
-        !self.triangles.is_empty()
-    }
-
-    /// The largest move of a surface particle from `start` to `x` relative to the
-    /// surfaces' mean move, metres. The mean is summed in particle order, so the same on
-    /// any thread count.
-    pub(crate) fn relative_move(&self, start: &[Vec3], x: &[Vec3]) -> f64 {
-        let d = |i: u32| x[i as usize] - start[i as usize];
-        let mean = self.particles.iter().fold(Vec3::zeros(), |m, &i| m + d(i))
-            / self.particles.len() as f64;
-        self.particles
-            .par_iter()
-            .with_min_len(4 * CHUNK)
-            .map(|&i| (d(i) - mean).norm())
-            .reduce(|| 0.0, f64::max)
-    }
-
     /// For each pair of surfaces that touch (a surface and itself included), the first
     /// triangle pair of them (by the lower triangle in the surfaces' order, so the same on
     /// any thread count) of which an edge of one passes through the other at `x`; pairs
     /// sharing a particle, and those `folds` watches, are left out.
-    pub(crate) fn crossings(&mut self, x: &[Vec3], folds: &Folds) -> Vec<Crossing> {
-        let triangles = &self.triangles;
+    pub(crate) fn crossings(
+        &mut self,
+        (triangles, surface): (&[[u32; 3]], &[u32]),
+        self_colliding: &(dyn Fn(u32) -> bool + Sync),
+        x: &[Vec3],
+        folds: &Folds,
+    ) -> Vec<Crossing> {
         triangles
             .par_iter()
             .with_min_len(CHUNK)
@@ -120,9 +74,7 @@ impl LayerWatch {
         }
         self.grid.build(cell, self.boxes.iter().map(|b| b.0));
         let (planes, boxes, grid) = (&self.planes, &self.boxes, &self.grid);
-        let (surface, self_collision) = (&self.surface, &self.self_collision);
-        let touch =
-            |i: usize, j: usize| surface[i] != surface[j] || self_collision[surface[i] as usize];
+        let touch = |i: usize, j: usize| surface[i] != surface[j] || self_colliding(surface[i]);
         // Every pair is looked at (a look that finds nothing, the usual one, does so
         // anyway), so that each pair of surfaces is said at every step it crossed.
         let found: Vec<(usize, usize, [u32; 3])> = (0..triangles.len())
@@ -195,18 +147,16 @@ fn overlap((a0, a1): &(Vec3, Vec3), (b0, b1): &(Vec3, Vec3)) -> bool {
 mod tests {
     use super::*;
 
-    /// A watch over `triangles`, each on the surface beside it, with `self_collision` per
-    /// surface.
-    fn watch(triangles: &[([u32; 3], u32)], self_collision: &[bool]) -> LayerWatch {
-        LayerWatch {
-            built: true,
-            triangles: triangles.iter().map(|t| t.0).collect(),
-            surface: triangles.iter().map(|t| t.1).collect(),
-            self_collision: self_collision.to_vec(),
-            particles: (0..8).collect(),
-            thickness: 0.005,
-            ..LayerWatch::default()
-        }
+    /// The crossings a look finds among `triangles`, each on the surface beside it, with
+    /// `self_collision` per surface.
+    fn look(triangles: &[([u32; 3], u32)], self_collision: &[bool], x: &[Vec3]) -> Vec<Crossing> {
+        let (tris, surface): (Vec<_>, Vec<_>) = triangles.iter().copied().unzip();
+        LayerWatch::default().crossings(
+            (&tris, &surface),
+            &|k| self_collision[k as usize],
+            x,
+            &Folds::default(),
+        )
     }
 
     /// A flat triangle in y = 0 (particles 0–2), an upright one whose edge 3–4 passes
@@ -226,8 +176,11 @@ mod tests {
 
     #[test]
     fn an_edge_through_another_surface_is_found_with_both_surfaces() {
-        let mut w = watch(&[([0, 1, 2], 0), ([3, 4, 5], 1)], &[false, false]);
-        let found = w.crossings(&positions(), &Folds::default());
+        let found = look(
+            &[([0, 1, 2], 0), ([3, 4, 5], 1)],
+            &[false, false],
+            &positions(),
+        );
         assert_eq!(found.len(), 1);
         assert_eq!(
             found[0].surfaces,
@@ -257,7 +210,7 @@ mod tests {
             ([6, 7, 8], 2),
             ([9, 10, 11], 0),
         ];
-        let found = watch(&tris, &[false, false, false]).crossings(&x, &Folds::default());
+        let found = look(&tris, &[false, false, false], &x);
         let pairs: Vec<_> = found.iter().map(|c| c.surfaces).collect();
         assert_eq!(pairs, [[1, 0], [2, 0]]);
     }
@@ -266,12 +219,8 @@ mod tests {
     fn one_surface_through_itself_counts_only_where_it_collides_with_itself() {
         let tris = [([0, 1, 2], 0), ([3, 4, 5], 0)];
         let x = positions();
-        assert!(
-            watch(&tris, &[false])
-                .crossings(&x, &Folds::default())
-                .is_empty()
-        );
-        let found = watch(&tris, &[true]).crossings(&x, &Folds::default());
+        assert!(look(&tris, &[false], &x).is_empty());
+        let found = look(&tris, &[true], &x);
         assert_eq!(found.len(), 1);
         assert_eq!(found[0].surfaces, [0, 0]);
     }
@@ -284,22 +233,6 @@ mod tests {
         for p in &mut x[3..6] {
             p.y += 2.5;
         }
-        assert!(
-            watch(&tris, &[true])
-                .crossings(&x, &Folds::default())
-                .is_empty()
-        );
-    }
-
-    #[test]
-    fn a_shared_motion_is_no_relative_move() {
-        let w = watch(&[([0, 1, 2], 0)], &[true]);
-        let start = positions();
-        let shift = Vec3::new(0.3, -2.0, 0.1);
-        let mut x: Vec<Vec3> = start.iter().map(|p| p + shift).collect();
-        assert!(w.relative_move(&start, &x) < 1e-12);
-        x[7].y += 0.01;
-        let moved = w.relative_move(&start, &x);
-        assert!((moved - 0.01 * 7.0 / 8.0).abs() < 1e-12, "{moved}");
+        assert!(look(&tris, &[true], &x).is_empty());
     }
 }

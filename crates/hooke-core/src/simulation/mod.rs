@@ -254,9 +254,8 @@ impl Simulation {
         self.workspace
             .ensure(&self.model, self.particles.len(), self.integrator);
         self.contacts = ContactState::new(self.particles.len());
-        // The watches list the surfaces' particles by number.
+        // The crossing watch lists the surfaces' particles by number.
         self.crossings = CrossingWatch::default();
-        self.layers = LayerWatch::default();
         self.watch.renumbered();
         self.last = StepReport {
             saved_start: false,
@@ -386,7 +385,9 @@ impl Simulation {
             let Some(start) = self.workspace.start_positions(report) else {
                 return;
             };
-            moved = self.crossings.largest_move(start, &self.particles.x);
+            moved = self
+                .crossings
+                .largest_move(start, &self.particles.x, Vec3::zeros());
             let (lo, hi) = summary::bounds(&self.particles.x);
             let sweep = self
                 .model
@@ -433,19 +434,24 @@ impl Simulation {
     /// come after it, and that moved a surface particle relative to the others more than
     /// they can follow, is recorded as a [`Notice`].
     fn watch_layers(&mut self, report: StepReport) {
-        if self.integrator.solves_contacts() || !self.layers.watches(&self.model) {
+        if self.integrator.solves_contacts() || !self.model.surfaces_touch() {
             return;
         }
         let Some(start) = self.workspace.start_positions(report) else {
             return;
         };
-        let moved = self.layers.relative_move(start, &self.particles.x);
-        let thickness = self.layers.thickness;
+        let (surfaces, x) = (&mut self.crossings, &self.particles.x);
+        surfaces.build(&self.model);
+        let moved = surfaces.largest_move(start, x, surfaces.mean_move(start, x));
+        let thickness = surfaces.thickness;
         if moved <= 0.5 * thickness {
             return;
         }
         let folds = self.contacts.exclusion().folds();
-        for found in self.layers.crossings(&self.particles.x, folds) {
+        let model = &self.model;
+        let self_colliding = |k: u32| model.surfaces[k as usize].self_collision;
+        let lists = (&surfaces.triangles[..], &surfaces.surface[..]);
+        for found in self.layers.crossings(lists, &self_colliding, x, folds) {
             let [a, b] = found.surfaces;
             // Two surfaces are named lower first, so that either passing through the other
             // is one kind of notice; the particle is on the first.

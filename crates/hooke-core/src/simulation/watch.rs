@@ -28,7 +28,10 @@ const CHUNK: usize = 512;
 pub(crate) struct CrossingWatch {
     built: bool,
     edges: Vec<[u32; 2]>,
-    triangles: Vec<[u32; 3]>,
+    /// The active surfaces' triangles in model order (the contact phase's, so that a
+    /// triangle's index is its exclusion's), and each one's surface.
+    pub(crate) triangles: Vec<[u32; 3]>,
+    pub(crate) surface: Vec<u32>,
     /// The surfaces' particles, for the step's largest move.
     particles: Vec<u32>,
     /// The thinnest contact thickness of the active surfaces (infinite without one).
@@ -38,12 +41,18 @@ pub(crate) struct CrossingWatch {
 }
 
 impl CrossingWatch {
-    fn build(&mut self, model: &Model) {
+    /// Reads the model's active surfaces, once.
+    pub(crate) fn build(&mut self, model: &Model) {
+        if self.built {
+            return;
+        }
         self.built = true;
         self.thickness = f64::INFINITY;
-        for (_, s) in model.active_surfaces() {
+        for (k, s) in model.active_surfaces() {
             self.edges.extend(s.edges());
             self.triangles.extend_from_slice(&s.triangles);
+            self.surface
+                .extend(std::iter::repeat_n(k as u32, s.triangles.len()));
             self.particles.extend(s.particles.clone().map(|i| i as u32));
             self.thickness = self.thickness.min(s.thickness);
         }
@@ -52,22 +61,30 @@ impl CrossingWatch {
     /// Whether the model has anything to watch: a surface with a thickness and a collider
     /// with a velocity-level response.
     pub(crate) fn watches(&mut self, model: &Model) -> bool {
-        if !self.built {
-            self.build(model);
-        }
+        self.build(model);
         !self.edges.is_empty() && model.colliders.iter().any(|c| !c.response.is_force())
     }
 
-    /// The largest distance a surface particle moved from `start` to `x`.
-    pub(crate) fn largest_move(&self, start: &[Vec3], x: &[Vec3]) -> f64 {
+    /// The largest distance a surface particle moved from `start` to `x`, less `shift`
+    /// (zero for the distance itself).
+    pub(crate) fn largest_move(&self, start: &[Vec3], x: &[Vec3], shift: Vec3) -> f64 {
         self.particles
             .par_chunks(CHUNK)
             .map(|ids| {
                 ids.iter()
-                    .map(|&i| (x[i as usize] - start[i as usize]).norm())
+                    .map(|&i| (x[i as usize] - start[i as usize] - shift).norm())
                     .fold(0.0, f64::max)
             })
             .reduce(|| 0.0, f64::max)
+    }
+
+    /// The surface particles' mean move from `start` to `x`, summed in particle order so
+    /// that it is the same on any thread count.
+    pub(crate) fn mean_move(&self, start: &[Vec3], x: &[Vec3]) -> Vec3 {
+        let sum = self.particles.iter().fold(Vec3::zeros(), |m, &i| {
+            m + (x[i as usize] - start[i as usize])
+        });
+        sum / self.particles.len() as f64
     }
 
     /// The first collider (in model order) that a surface passes through at `x`, and the
@@ -115,5 +132,26 @@ impl CrossingWatch {
             }
         }
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shared_motion_is_no_relative_move() {
+        let w = CrossingWatch {
+            particles: (0..8).collect(),
+            ..CrossingWatch::default()
+        };
+        let start: Vec<Vec3> = (0..8).map(|i| Vec3::new(i as f64, 0.5, -0.2)).collect();
+        let shift = Vec3::new(0.3, -2.0, 0.1);
+        let mut x: Vec<Vec3> = start.iter().map(|p| p + shift).collect();
+        let relative = |x: &[Vec3]| w.largest_move(&start, x, w.mean_move(&start, x));
+        assert!(relative(&x) < 1e-12);
+        x[7].y += 0.01;
+        let moved = relative(&x);
+        assert!((moved - 0.01 * 7.0 / 8.0).abs() < 1e-12, "{moved}");
     }
 }
