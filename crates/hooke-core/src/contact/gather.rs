@@ -2,9 +2,12 @@
 //! hashed grids, and particle–triangle and edge–edge pairs gathered in fixed chunks, so
 //! that the lists come out in the same order on any thread count.
 
+use super::crowding::{Caps, Count, Crowded};
 use super::exclusion::Exclusion;
 use super::grid::Grid;
-use super::proximity::{point_triangle, segment_segment};
+use super::proximity::{feature_gap, point_triangle, segment_segment};
+use super::stencil::Rule;
+use crate::collider::Feature;
 use crate::model::Model;
 use crate::particles::Vec3;
 use rayon::prelude::*;
@@ -24,16 +27,19 @@ impl Prims<'_> {
     /// Replaces `point_tri` and `edge_edge` with the particle–triangle and edge–edge pairs of
     /// surfaces that collide nearer than `reach` at `x`, found through `bins` (binned at `x`
     /// with that reach): by particle, then by the particle's cells and triangle; by edge,
-    /// then by the edge's cells and the other edge.
+    /// then by the edge's cells and the other edge. More pairs of either kind than `caps`
+    /// allow are [`Crowded`]: the lists are then left empty.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn gather(
         &self,
         bins: &Bins,
         x: &[Vec3],
         reach: f64,
+        caps: Caps,
         scratch: &mut Vec<Vec<[u32; 2]>>,
         point_tri: &mut Vec<[u32; 2]>,
         edge_edge: &mut Vec<[u32; 2]>,
-    ) {
+    ) -> Result<(), Crowded> {
         let (model, owners) = (self.model, self.owners);
         // Exact distances at the build: while no particle moves more than half a skin, no
         // pair farther apart than the thickness plus the skin can come within the thickness.
@@ -42,8 +48,16 @@ impl Prims<'_> {
         let (edges, edge_box, edge_grid) = (self.edges, &bins.edge_box, &bins.edge_grid);
         let points = self.points;
 
+        point_tri.clear();
+        edge_edge.clear();
+
         // Particle against triangle: the triangle's low cell is the particle's or one below.
+        let count = Count::new(caps.point_tri);
         par_fill(points.len(), scratch, |i, out| {
+            if count.full() {
+                return;
+            }
+            let before = out.len();
             let p = points[i];
             let xp = x[p as usize];
             let c = tri_grid.cell_of(&xp);
@@ -64,13 +78,19 @@ impl Prims<'_> {
                     }
                 });
             }
+            count.add(out.len() - before);
         });
-        point_tri.clear();
+        count.verdict()?;
         append(point_tri, scratch);
 
         // Edge against edge: each pair once, from its lower edge, over the edge's own cell
         // and the 13 neighbours of one half-space (the other 13 see it from theirs).
+        let count = Count::new(caps.edge_edge);
         par_fill(edges.len(), scratch, |e, out| {
+            if count.full() {
+                return;
+            }
+            let before = out.len();
             let e = e as u32;
             let c = edge_grid.item_cell(e);
             let ee = edges[e as usize];
@@ -95,10 +115,81 @@ impl Prims<'_> {
                     }
                 });
             }
+            count.add(out.len() - before);
         });
-        edge_edge.clear();
+        if let Err(crowded) = count.verdict() {
+            point_tri.clear();
+            return Err(crowded);
+        }
         append(edge_edge, scratch);
+        Ok(())
     }
+}
+
+/// A triangle near a collider feature.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct FeaturePair {
+    pub(super) tri: u32,
+    pub(super) feature: Feature,
+    pub(super) rule: Rule,
+    /// The collider's index (for its velocity).
+    pub(super) collider: u16,
+}
+
+/// Replaces `pairs` with the collider feature–triangle pairs nearer than `reach` at `x`,
+/// found through `bins` (binned at `x` with that reach), by triangle; `features` is the
+/// colliders' features near the triangles, kept for its buffer.
+pub(super) fn feature_pairs(
+    model: &Model,
+    (bins, tris): (&Bins, &[[u32; 3]]),
+    x: &[Vec3],
+    reach: f64,
+    (features, pairs): (&mut Vec<(Feature, Rule, u16)>, &mut Vec<FeaturePair>),
+) {
+    pairs.clear();
+    features.clear();
+    if tris.is_empty() {
+        return;
+    }
+    let (lo, hi) = bins
+        .tri_box
+        .iter()
+        .fold((bins.tri_box[0].0, bins.tri_box[0].1), |(lo, hi), b| {
+            (lo.inf(&b.0), hi.sup(&b.1))
+        });
+    for (k, slot) in model.colliders.iter().enumerate() {
+        if !slot.shape.has_features() {
+            continue;
+        }
+        let rule = Rule::of(&slot.response);
+        slot.shape
+            .features(&lo, &hi, &mut |f| features.push((f, rule, k as u16)));
+    }
+    for &(feature, rule, collider) in features.iter() {
+        let (flo, fhi) = feature.bounds();
+        let (c0, c1) = (bins.tri_grid.cell_of(&flo), bins.tri_grid.cell_of(&fhi));
+        for i in c0[0] - 1..=c1[0] {
+            for j in c0[1] - 1..=c1[1] {
+                for k in c0[2] - 1..=c1[2] {
+                    bins.tri_grid.visit([i, j, k], |t| {
+                        let b = &bins.tri_box[t as usize];
+                        if overlap(b, &(flo, fhi))
+                            && feature_gap(&feature, &tris[t as usize], x, reach).is_some()
+                        {
+                            pairs.push(FeaturePair {
+                                tri: t,
+                                feature,
+                                rule,
+                                collider,
+                            });
+                        }
+                    });
+                }
+            }
+        }
+    }
+    // One order whatever the features' order: by triangle, then as found.
+    pairs.sort_by_key(|p| p.tri);
 }
 
 /// Boxes of triangles and edges grown by a reach, and grids of them.

@@ -34,6 +34,7 @@
 //! results are the same bits on any thread count.
 
 mod budgets;
+pub(crate) mod crowding;
 pub(crate) mod exclusion;
 mod gather;
 pub(crate) mod grid;
@@ -46,8 +47,9 @@ use crate::collider::response::coulomb_cut;
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
 use budgets::{Budgets, next_budget};
+use crowding::{Caps, Crowded};
 use exclusion::{Exclusion, Surfaces};
-use gather::{Bins, Prims, append, overlap, pair, par_fill};
+use gather::{Bins, FeaturePair, Prims, append, pair, par_fill};
 use proximity::{feature_gap, point_triangle, segment_segment};
 use respond::{FaceSkip, respond_all, respond_one};
 use std::time::Instant;
@@ -74,16 +76,6 @@ pub struct ContactStats {
     pub candidates: usize,
 }
 
-/// A triangle near a collider feature.
-#[derive(Clone, Copy, Debug)]
-struct FeaturePair {
-    tri: u32,
-    feature: Feature,
-    rule: Rule,
-    /// The collider's index (for its velocity).
-    collider: u16,
-}
-
 /// The contact phase's topology, candidate lists and buffers, kept from step to step.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ContactState {
@@ -105,6 +97,8 @@ pub(crate) struct ContactState {
     /// Largest thickness, and how far beyond it candidates reach.
     h_max: f64,
     skin: f64,
+    /// How many candidate pairs surfaces kept apart can hold (`crowding.rs`).
+    caps: Caps,
     /// Positions at the last build of the surface pairs and of the feature pairs.
     self_ref: Vec<Vec3>,
     feature_ref: Vec<Vec3>,
@@ -199,6 +193,12 @@ impl ContactState {
         };
         let (radius, pinned) = (2.0 * self.h_max, |i| p.is_pinned(i as usize));
         self.exclusion = Exclusion::new(&surfaces, rest, (radius, self.h_max), &pinned);
+        let thinnest = model
+            .active_surfaces()
+            .map(|(_, s)| s.thickness)
+            .fold(f64::INFINITY, f64::min);
+        let prims = (self.points.len(), &self.tris[..], &self.edges[..]);
+        self.caps = Caps::new(rest, prims, thinnest, self.reach());
     }
 
     /// The largest displacement of a surface particle from `x_ref`, measured from `shift`
@@ -216,7 +216,8 @@ impl ContactState {
     /// common shift, so the surface pairs are rebuilt when some particle has moved more than
     /// half a skin relative to the mean motion (a cloth falling as a whole keeps its lists),
     /// the feature pairs when one has moved that far at all (colliders stand still).
-    fn refresh(&mut self, model: &Model, x: &[Vec3]) {
+    /// Surfaces found crushed through themselves are [`Crowded`] (`crowding.rs`).
+    fn refresh(&mut self, model: &Model, x: &[Vec3]) -> Result<(), Crowded> {
         let limit = 0.25 * self.skin * self.skin;
         let self_stale = self.self_ref.is_empty() || {
             let n = self.points.len() as f64;
@@ -233,14 +234,18 @@ impl ContactState {
                 .any(|c| c.shape.is_moving() && c.shape.has_features())
             || self.drift2(x, &self.feature_ref, Vec3::zeros()) > limit;
         if !(self_stale || features_stale) {
-            return;
+            return Ok(());
         }
         self.stats.rebuilds += 1;
         self.bin(x);
         if self_stale {
             self.self_ref.clear();
             self.self_ref.extend_from_slice(x);
-            self.build_surface_pairs(model, x);
+            if let Err(crowded) = self.build_surface_pairs(model, x) {
+                // No list stands for these positions: the next look builds anew.
+                self.self_ref.clear();
+                return Err(crowded);
+            }
         }
         if features_stale {
             self.feature_ref.clear();
@@ -249,6 +254,7 @@ impl ContactState {
         }
         self.stats.candidates =
             self.point_tri.len() + self.edge_edge.len() + self.feature_pairs.len();
+        Ok(())
     }
 
     /// How far candidates reach: the thickness plus the skin.
@@ -263,7 +269,7 @@ impl ContactState {
     }
 
     /// Particle–triangle and edge–edge candidates at `x` (after [`ContactState::bin`]).
-    fn build_surface_pairs(&mut self, model: &Model, x: &[Vec3]) {
+    fn build_surface_pairs(&mut self, model: &Model, x: &[Vec3]) -> Result<(), Crowded> {
         let mut scratch = std::mem::take(&mut self.pair_scratch);
         let reach = self.reach();
         let (mut point_tri, mut edge_edge) = (
@@ -278,10 +284,11 @@ impl ContactState {
             tris: &self.tris,
             edges: &self.edges,
         };
-        prims.gather(
+        let gathered = prims.gather(
             &self.bins,
             x,
             reach,
+            self.caps,
             &mut scratch,
             &mut point_tri,
             &mut edge_edge,
@@ -296,59 +303,14 @@ impl ContactState {
         self.travel.clear();
         self.travel.resize(x.len(), 0.0);
         self.fresh = true;
+        gathered
     }
 
     /// Collider feature–triangle candidates at `x` (after [`ContactState::bin`]).
     fn build_feature_pairs(&mut self, model: &Model, x: &[Vec3]) {
         let reach = self.reach();
-        self.feature_pairs.clear();
-        self.features.clear();
-        if self.tris.is_empty() {
-            return;
-        }
-        let (lo, hi) = self.bins.tri_box.iter().fold(
-            (self.bins.tri_box[0].0, self.bins.tri_box[0].1),
-            |(lo, hi), b| (lo.inf(&b.0), hi.sup(&b.1)),
-        );
-        for (k, slot) in model.colliders.iter().enumerate() {
-            if !slot.shape.has_features() {
-                continue;
-            }
-            let rule = Rule::of(&slot.response);
-            let features = &mut self.features;
-            slot.shape
-                .features(&lo, &hi, &mut |f| features.push((f, rule, k as u16)));
-        }
-        for &(feature, rule, collider) in &self.features {
-            let (flo, fhi) = feature.bounds();
-            let (c0, c1) = (
-                self.bins.tri_grid.cell_of(&flo),
-                self.bins.tri_grid.cell_of(&fhi),
-            );
-            for i in c0[0] - 1..=c1[0] {
-                for j in c0[1] - 1..=c1[1] {
-                    for k in c0[2] - 1..=c1[2] {
-                        let (boxes, pairs) = (&self.bins.tri_box, &mut self.feature_pairs);
-                        let tris = &self.tris;
-                        self.bins.tri_grid.visit([i, j, k], |t| {
-                            let b = &boxes[t as usize];
-                            if overlap(b, &(flo, fhi))
-                                && feature_gap(&feature, &tris[t as usize], x, reach).is_some()
-                            {
-                                pairs.push(FeaturePair {
-                                    tri: t,
-                                    feature,
-                                    rule,
-                                    collider,
-                                });
-                            }
-                        });
-                    }
-                }
-            }
-        }
-        // One order whatever the features' order: by triangle, then as found.
-        self.feature_pairs.sort_by_key(|p| p.tri);
+        let lists = (&mut self.features, &mut self.feature_pairs);
+        gather::feature_pairs(model, (&self.bins, &self.tris), x, reach, lists);
     }
 
     /// Adds to every surface particle's travel the path since the last detection: the leg
@@ -482,13 +444,14 @@ impl ContactState {
 }
 
 /// Runs the contact phase after an integrator step: `x0` are the step's start positions.
-/// Returns whether it may have moved any particle.
+/// Returns whether it may have moved any particle, or that the step crushed the surfaces
+/// through themselves (`crowding.rs`): then it moved nothing after the colliders' faces.
 pub(crate) fn phase(
     model: &Model,
     p: &mut Particles,
     x0: &[Vec3],
     state: &mut ContactState,
-) -> bool {
+) -> Result<bool, Crowded> {
     let started = Instant::now();
     if !state.ready {
         state.prepare(model, p.len());
@@ -518,9 +481,9 @@ pub(crate) fn phase(
     );
     if state.points.is_empty() {
         state.stats.seconds += started.elapsed().as_secs_f64();
-        return moved;
+        return Ok(moved);
     }
-    state.refresh(model, &p.x);
+    state.refresh(model, &p.x)?;
     state.active.clear();
     state.detect(model, &p.x, x0);
     for _ in 0..SWEEPS {
@@ -589,5 +552,5 @@ pub(crate) fn phase(
     }
     state.stats.proximities = state.active.len();
     state.stats.seconds += started.elapsed().as_secs_f64();
-    true
+    Ok(true)
 }

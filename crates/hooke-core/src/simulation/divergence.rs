@@ -6,6 +6,7 @@
 //! the stability estimate at the *start* of the step: the diverged state itself has no
 //! meaningful geometry.
 
+use crate::contact::crowding::Crowded;
 use crate::integrator::Integrator;
 use crate::model::Model;
 use crate::parallel;
@@ -55,6 +56,9 @@ pub(crate) struct StepEnd<'a> {
     pub start: Option<&'a [Vec3]>,
     /// The integrator's own verdict on the state, if it checked it in its last pass.
     pub verdict: Option<bool>,
+    /// The contact phase found the surfaces crushed through themselves (more candidate
+    /// pairs than they can hold apart): a divergence whatever the sanity check says.
+    pub crowded: Option<Crowded>,
     /// The step's number (1-based), the integrator and its step size.
     pub step: u64,
     pub integrator: Integrator,
@@ -65,15 +69,13 @@ pub(crate) struct StepEnd<'a> {
 /// [`Divergence`] with the first bad particle and the estimate at the step's start.
 pub(crate) fn check(end: StepEnd<'_>) -> Result<(), Divergence> {
     let p = end.particles;
-    if end
-        .verdict
-        .unwrap_or_else(|| parallel::all_sane(&p.x, &p.v, SANE_BOUND))
+    if end.crowded.is_none()
+        && end
+            .verdict
+            .unwrap_or_else(|| parallel::all_sane(&p.x, &p.v, SANE_BOUND))
     {
         return Ok(());
     }
-    let Some((particle, what)) = first_bad(p) else {
-        return Ok(());
-    };
     let mut at_start = p.clone();
     match end.start {
         Some(x0) => at_start.x.copy_from_slice(x0),
@@ -83,6 +85,13 @@ pub(crate) fn check(end: StepEnd<'_>) -> Result<(), Divergence> {
             }
         }
     }
+    let bad = match end.crowded {
+        Some(crowded) => Some((farthest(&at_start.x, &p.x), crowding(crowded))),
+        None => first_bad(p),
+    };
+    let Some((particle, what)) = bad else {
+        return Ok(());
+    };
     // A state that already overflowed has no geometry to linearise at: bound the frequency
     // from the springs' stiffness and the masses alone.
     let finite = at_start.x.iter().all(|x| x.iter().all(|c| c.is_finite()));
@@ -117,6 +126,28 @@ pub(crate) fn suggested(stable_dt: f64, dt: f64) -> f64 {
     } else {
         0.0
     }
+}
+
+/// The particle that moved farthest from `start` to `x` (the lowest-numbered of equals).
+fn farthest(start: &[Vec3], x: &[Vec3]) -> usize {
+    let mut best = (0, -1.0);
+    for (i, (a, b)) in start.iter().zip(x).enumerate() {
+        let d = (b - a).norm();
+        if d > best.1 {
+            best = (i, d);
+        }
+    }
+    best.0
+}
+
+/// What a step that crushed the surfaces did to its farthest-moved particle.
+fn crowding(crowded: Crowded) -> String {
+    format!(
+        "moved farthest in a step that left over {} pairs of surface primitives within the \
+         contacts' reach of each other, more than surfaces kept a thickness apart can hold: \
+         the step crushed or tore them through themselves",
+        crowded.limit
+    )
 }
 
 /// The lowest-numbered particle in a bad state, and what is wrong with it.

@@ -99,6 +99,14 @@ impl LayerWatch {
                                 {
                                     return;
                                 }
+                                // Only a triangle's first crossing with each surface can
+                                // be its pair's first: a tangle of thousands keeps one.
+                                let seen = |&(_, k, _): &(usize, usize, [u32; 3])| {
+                                    surface[k] == surface[j]
+                                };
+                                if found.iter().any(seen) {
+                                    return;
+                                }
                                 if let Some(corners) =
                                     through((ta, &planes[i]), (tb, &planes[j]), x)
                                 {

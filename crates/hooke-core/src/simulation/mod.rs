@@ -333,20 +333,29 @@ impl Simulation {
         }
         // Every scheme saves its start positions when the model has a contact phase.
         // Block descent keeps its contacts inside its own iterations.
-        let moved = self.model.has_contact_phase()
-            && !self.integrator.solves_contacts()
-            && contact::phase(
+        let phase = if self.model.has_contact_phase() && !self.integrator.solves_contacts() {
+            contact::phase(
                 &self.model,
                 &mut self.particles,
                 &self.workspace.x0,
                 &mut self.contacts,
-            );
+            )
+        } else {
+            Ok(false)
+        };
         self.step += 1;
         self.end_pins(time + self.dt);
-        self.watch_crossings(time, report);
-        self.watch_layers(report);
-        self.watch_folds();
+        let (moved, crowded) = match phase {
+            Ok(moved) => (moved, None),
+            Err(crowded) => (true, Some(crowded)),
+        };
+        if crowded.is_none() {
+            self.watch_crossings(time, report);
+            self.watch_layers(report);
+            self.watch_folds();
+        }
         divergence::check(StepEnd {
+            crowded,
             model: &self.model,
             particles: &self.particles,
             initial: &self.initial,
