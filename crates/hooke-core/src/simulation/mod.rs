@@ -409,33 +409,29 @@ impl Simulation {
             }
             moved += sweep;
         }
-        let Some((collider, ids)) = self
-            .crossings
-            .first_crossing(&self.model, &self.particles.x)
-        else {
-            return;
-        };
-        let pinned = ids.iter().find(|&&i| self.particles.is_pinned(i as usize));
-        let cause = if !vbd {
-            Cause::LargeStep {
-                integrator: self.integrator,
-                moved,
-                thickness: self.crossings.thickness,
-            }
-        } else if pinned.is_some() {
-            Cause::Pinned
-        } else {
-            Cause::Squeezed {
-                parts: self.workspace.vbd.step_parts,
-            }
-        };
-        self.notices.record(Notice {
-            step: self.step,
-            time: self.time(),
-            through: Through::Collider(collider),
-            particle: *pinned.unwrap_or(&ids[0]) as usize,
-            cause,
-        });
+        for (collider, ids) in self.crossings.crossings(&self.model, &self.particles.x) {
+            let pinned = ids.iter().find(|&&i| self.particles.is_pinned(i as usize));
+            let cause = if !vbd {
+                Cause::LargeStep {
+                    integrator: self.integrator,
+                    moved,
+                    thickness: self.crossings.thickness,
+                }
+            } else if pinned.is_some() {
+                Cause::Pinned
+            } else {
+                Cause::Squeezed {
+                    parts: self.workspace.vbd.step_parts,
+                }
+            };
+            self.notices.record(Notice {
+                step: self.step,
+                time: self.time(),
+                through: Through::Collider(collider),
+                particle: *pinned.unwrap_or(&ids[0]) as usize,
+                cause,
+            });
+        }
     }
 
     /// The watch on layers after a large step ([`layers`], docs/physics.md §3.5): a

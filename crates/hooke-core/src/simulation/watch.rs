@@ -87,10 +87,11 @@ impl CrossingWatch {
         sum / self.particles.len() as f64
     }
 
-    /// The first collider (in model order) that a surface passes through at `x`, and the
+    /// Each collider (in model order) that a surface passes through at `x`, with the
     /// particles of the first edge or triangle that does (in surface order; an edge's first
     /// end twice): the same on any thread count.
-    pub(crate) fn first_crossing(&self, model: &Model, x: &[Vec3]) -> Option<(usize, [u32; 3])> {
+    pub(crate) fn crossings(&self, model: &Model, x: &[Vec3]) -> Vec<(usize, [u32; 3])> {
+        let mut found = Vec::new();
         for (k, slot) in model.colliders.iter().enumerate() {
             if slot.response.is_force() {
                 continue;
@@ -106,7 +107,8 @@ impl CrossingWatch {
                     shape.may_touch(&lo, &hi, 0.0) && shape.segment_meets(p, q)
                 });
             if let Some(&[a, b]) = edge {
-                return Some((k, [a, b, a]));
+                found.push((k, [a, b, a]));
+                continue;
             }
             if !shape.has_features() {
                 continue;
@@ -128,10 +130,10 @@ impl CrossingWatch {
                     through
                 });
             if let Some(&tri) = triangle {
-                return Some((k, tri));
+                found.push((k, tri));
             }
         }
-        None
+        found
     }
 }
 
