@@ -22,20 +22,27 @@ pub(in crate::integrator) fn chunked<T: Send>(
     n: usize,
     f: impl Fn(Range<usize>) -> Vec<T> + Sync + Send,
 ) -> Vec<T> {
+    concatenate(parts(n, f))
+}
+
+/// `f` over fixed chunks of `0..n` in parallel, each chunk's results as one part, in chunk
+/// order: read end to end, they are [`chunked`]'s without a copy of them all.
+pub(in crate::integrator) fn parts<T: Send>(
+    n: usize,
+    f: impl Fn(Range<usize>) -> Vec<T> + Sync + Send,
+) -> Vec<Vec<T>> {
     if n <= CHUNK {
-        return f(0..n);
+        return vec![f(0..n)];
     }
-    let parts: Vec<Vec<T>> = (0..n.div_ceil(CHUNK))
+    (0..n.div_ceil(CHUNK))
         .into_par_iter()
         .map(|c| {
             let mut part = f(c * CHUNK..((c + 1) * CHUNK).min(n));
-            // Without its growth's slack: the parts and their concatenation are the
-            // detection's peak memory.
+            // Without its growth's slack: the parts are the pair list's memory.
             part.shrink_to_fit();
             part
         })
-        .collect();
-    concatenate(parts)
+        .collect()
 }
 
 /// `parts` end to end, in one allocation of exactly their length (a flattening collect
@@ -82,7 +89,8 @@ pub(in crate::integrator) fn bin(grid: &mut Grid, boxes: &[(Vec3, Vec3)], reach:
 /// Calls `test(q, candidates, out)` for every query `q` whose cell is `cells[q]`, with the
 /// items of the 27 cells around that cell (every item whose low corner lies within one cell
 /// of the query's), gathered once per occupied cell. Results come in the order of (cell,
-/// query): fixed by the positions alone, never by threads.
+/// query), in parts of consecutive cells ([`parts`]): fixed by the positions alone, never by
+/// threads.
 ///
 /// `boxes` (each query's box, each item's box, the reach) prunes a cell's items to those
 /// whose box comes within the reach of its queries' joint box (by a nanometre more, so
@@ -93,7 +101,7 @@ pub(in crate::integrator) fn by_cell<T: Send>(
     cells: &[Cell],
     boxes: (&QueryBox<'_>, &[Aabb], f64),
     test: impl Fn(usize, &[u32], &mut Vec<T>) + Sync + Send,
-) -> Vec<T> {
+) -> Vec<Vec<T>> {
     let (query_box, item_boxes, reach) = boxes;
     let pad = reach + 1e-9;
     let mut order: Vec<u32> = (0..cells.len() as u32).collect();
@@ -102,7 +110,7 @@ pub(in crate::integrator) fn by_cell<T: Send>(
         .filter(|&k| k == 0 || cells[order[k] as usize] != cells[order[k - 1] as usize])
         .collect();
     starts.push(order.len());
-    chunked(starts.len() - 1, |groups| {
+    parts(starts.len() - 1, |groups| {
         let mut out = Vec::new();
         let mut candidates = Vec::new();
         for g in groups {
