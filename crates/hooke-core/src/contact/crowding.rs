@@ -124,27 +124,6 @@ pub(crate) struct Crowded {
 mod tests {
     use super::*;
 
-    /// A flat grid of `n × n` particles at `spacing`, as triangles and edges.
-    fn grid(n: usize, spacing: f64) -> (Vec<Vec3>, Vec<[u32; 3]>, Vec<[u32; 2]>) {
-        let mut x = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                x.push(Vec3::new(i as f64 * spacing, 0.0, j as f64 * spacing));
-            }
-        }
-        let (mut tris, mut edges) = (Vec::new(), Vec::new());
-        for j in 0..n - 1 {
-            for i in 0..n - 1 {
-                let a = (j * n + i) as u32;
-                let (b, c, d) = (a + 1, a + n as u32, a + n as u32 + 1);
-                tris.push([a, b, d]);
-                tris.push([a, d, c]);
-                edges.extend([[a, b], [a, c], [a, d]]);
-            }
-        }
-        (x, tris, edges)
-    }
-
     /// The cap sits between what a pile of layers a thickness apart holds and what a
     /// cloth blown up in its own plane finds: every particle of a 64² sheet within the
     /// reach of every other's triangles.
@@ -152,8 +131,10 @@ mod tests {
     fn a_stack_of_layers_fits_and_a_sheet_over_itself_does_not() {
         let (spacing, h) = (0.01, 0.0025);
         let reach = 3.0 * h;
-        let (x, tris, edges) = grid(64, spacing);
-        let caps = Caps::new(&x, (x.len(), &tris, &edges), h, reach);
+        let at = |i: usize, j: usize| Vec3::new(i as f64 * spacing, 0.0, j as f64 * spacing);
+        let (model, x) = crate::contact::exclusion::tests::sheet(64, h, |_, _| false, at);
+        let (tris, edges) = (&model.surfaces[0].triangles, model.surfaces[0].edges());
+        let caps = Caps::new(&x, (x.len(), tris, &edges), h, reach);
         // Seven layers a thickness apart (the most the reach can hold around a particle):
         // each particle within the reach of about (2 reach / spacing)² · 2 triangles of each.
         let stacked = x.len() as f64 * 7.0 * 2.0 * (2.0 * reach / spacing + 1.0).powi(2);

@@ -367,4 +367,4 @@ impl Exclusion {
 
 mod folds;
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

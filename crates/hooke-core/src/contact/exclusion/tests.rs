@@ -17,7 +17,7 @@ fn noise(seed: u64) -> impl FnMut() -> f64 {
 
 /// An `n`×`n` sheet of spacing `s` in the x-z plane, its quads split along a diagonal
 /// that `flip` chooses, its points placed by `at(i, j)`; thickness `h`.
-fn sheet(
+pub(crate) fn sheet(
     n: usize,
     h: f64,
     mut flip: impl FnMut(usize, usize) -> bool,
