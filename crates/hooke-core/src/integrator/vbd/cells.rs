@@ -22,6 +22,10 @@ pub(in crate::integrator) fn chunked<T: Send>(
     n: usize,
     f: impl Fn(Range<usize>) -> Vec<T> + Sync + Send,
 ) -> Vec<T> {
+    // One chunk is its own result: no copy of it.
+    if n <= CHUNK {
+        return f(0..n);
+    }
     concatenate(parts(n, f))
 }
 
