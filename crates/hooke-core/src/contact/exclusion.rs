@@ -51,7 +51,8 @@ const MOST: usize = 2048;
 /// one round cloth draped 4 % and 5 % less wide than the coarser (`tests/meshes.rs`).
 const PATH: f64 = 1.0;
 
-/// Sorted lists, one per particle (triangles) and one per edge (edges), in one array each.
+/// Sorted lists, one per particle (its skipped triangles) and one per edge (the skipped
+/// edges below it: each pair once), in one array each.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Exclusion {
     triangle_start: Vec<u32>,
@@ -202,6 +203,25 @@ fn listed(start: &[u32], all: &[u32], i: u32, k: u32) -> bool {
     list(start, all, i as usize).binary_search(&k).is_ok()
 }
 
+/// Each pair of a symmetric relation given as `lists` (`f` in `lists[e]`, or `e` in
+/// `lists[f]`) once, under its larger index: the edges' lists hold most pairs from both
+/// sides, and one lookup then answers for the pair.
+fn once(lists: Vec<Vec<u32>>) -> Vec<Vec<u32>> {
+    let mut out = vec![Vec::new(); lists.len()];
+    for (e, list) in lists.into_iter().enumerate() {
+        let e = e as u32;
+        for f in list {
+            out[e.max(f) as usize].push(e.min(f));
+        }
+    }
+    for list in &mut out {
+        list.sort_unstable();
+        list.dedup();
+        list.shrink_to_fit();
+    }
+    out
+}
+
 /// Lists in one array and their starts.
 fn flatten(lists: Vec<Vec<u32>>) -> (Vec<u32>, Vec<u32>) {
     let mut start = Vec::with_capacity(lists.len() + 1);
@@ -317,7 +337,7 @@ impl Exclusion {
             )
             .collect();
         let (triangle_start, triangles) = flatten(triangles);
-        let (edge_start, edges) = flatten(edges);
+        let (edge_start, edges) = flatten(once(edges));
         let skipped = Skipped {
             triangle_start: &triangle_start,
             triangles: &triangles,
@@ -352,13 +372,14 @@ impl Exclusion {
         listed(&self.triangle_start, &self.triangles, v, t)
     }
 
-    /// Whether the pair of edges `e` and `f` is skipped: either is in the other's set.
+    /// Whether the pair of edges `e` and `f` is skipped: either is in the other's set (the
+    /// pair is listed once, under the larger index).
     #[inline]
     pub(crate) fn skips_edges(&self, e: u32, f: u32) -> bool {
-        listed(&self.edge_start, &self.edges, e, f) || listed(&self.edge_start, &self.edges, f, e)
+        listed(&self.edge_start, &self.edges, e.max(f), e.min(f))
     }
 
-    /// How many pairs are listed (an edge pair once or twice).
+    /// How many pairs are listed.
     #[cfg(test)]
     fn len(&self) -> usize {
         self.triangles.len() + self.edges.len()

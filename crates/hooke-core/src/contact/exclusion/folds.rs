@@ -18,18 +18,22 @@ use super::{list, listed};
 use crate::particles::Vec3;
 use rayon::prelude::*;
 
-/// Pairs per parallel chunk of the check.
+/// Triangles (or pairs) per parallel chunk of the check.
 const CHUNK: usize = 1024;
 
 /// An edge end nearer a triangle's plane than this, metres, is on it, not through it: a
 /// flat sheet's neighbours lie in one plane to rounding, and a crossing is deeper.
 const ON_PLANE: f64 = 1e-9;
 
-/// The triangle pairs watched, each as two triangles' corners (lower index first).
+/// The triangle pairs watched: the triangles' corners, and each pair under its lower
+/// index, in index order.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Folds {
     triangles: Vec<[u32; 3]>,
-    pairs: Vec<[u32; 2]>,
+    /// Triangle `a`'s watched partners (each above `a`, ascending) are
+    /// `partners[start[a]..start[a + 1]]`; `start` is empty when nothing is watched.
+    start: Vec<u32>,
+    partners: Vec<u32>,
 }
 
 /// Whether two triangles share a particle.
@@ -37,8 +41,8 @@ fn share(a: &[u32; 3], b: &[u32; 3]) -> bool {
     a.iter().any(|i| b.contains(i))
 }
 
-/// The skipped pairs as lists: per particle its skipped triangles, per edge its skipped
-/// edges (each the range `start[i]..start[i + 1]` of `all`).
+/// The skipped pairs as lists: per particle its skipped triangles, per edge the skipped
+/// edges below it, each pair once (each the range `start[i]..start[i + 1]` of `all`).
 pub(super) struct Skipped<'a> {
     pub(super) triangle_start: &'a [u32],
     pub(super) triangles: &'a [u32],
@@ -106,10 +110,27 @@ impl Folds {
         let mut pairs: Vec<[u32; 2]> = by_particle.chain(by_edge).collect();
         pairs.par_sort_unstable();
         pairs.dedup();
+        // One index a pair, under its first triangle's: half the memory of the pairs.
+        let mut start = Vec::with_capacity(triangles.len() + 1);
+        let mut partners = Vec::with_capacity(pairs.len());
+        start.push(0);
+        for a in 0..triangles.len() as u32 {
+            let first = partners.len();
+            let rest = &pairs[first..];
+            let run = rest.iter().take_while(|p| p[0] == a).count();
+            partners.extend(rest[..run].iter().map(|p| p[1]));
+            start.push(partners.len() as u32);
+        }
         Self {
             triangles: triangles.to_vec(),
-            pairs,
+            start,
+            partners,
         }
+    }
+
+    /// Triangle `a`'s watched partners.
+    fn partners(&self, a: usize) -> &[u32] {
+        &self.partners[self.start[a] as usize..self.start[a + 1] as usize]
     }
 
     /// The first watched pair (in the lists' order, so the same on any thread count) of
@@ -117,7 +138,7 @@ impl Folds {
     /// triangle whose edge passes, that edge's two first. `planes` is a buffer kept
     /// between calls.
     pub(crate) fn first_through(&self, x: &[Vec3], planes: &mut Vec<Plane>) -> Option<[u32; 3]> {
-        if self.pairs.is_empty() {
+        if self.partners.is_empty() {
             return None;
         }
         self.triangles
@@ -126,25 +147,28 @@ impl Folds {
             .map(|t| Plane::of(t, x))
             .collect_into_vec(planes);
         let planes = &planes[..];
-        self.pairs
-            .par_iter()
-            .with_min_len(CHUNK)
-            .find_map_first(|&[a, b]| {
-                let (ta, tb) = (&self.triangles[a as usize], &self.triangles[b as usize]);
-                through((ta, &planes[a as usize]), (tb, &planes[b as usize]), x)
+        (0..self.triangles.len())
+            .into_par_iter()
+            // Some sixteen partners a triangle on a fine sheet: chunks of about CHUNK pairs.
+            .with_min_len(CHUNK / 16)
+            .flat_map_iter(|a| self.partners(a).iter().map(move |&b| (a, b as usize)))
+            .find_map_first(|(a, b)| {
+                let (ta, tb) = (&self.triangles[a], &self.triangles[b]);
+                through((ta, &planes[a]), (tb, &planes[b]), x)
             })
     }
 
     /// Whether triangles `a` and `b` (as the exclusion indexes them) are a watched pair:
     /// one that only a skipped pair could bring through each other.
     pub(crate) fn watches(&self, a: u32, b: u32) -> bool {
-        self.pairs.binary_search(&[a.min(b), a.max(b)]).is_ok()
+        let (a, b) = (a.min(b), a.max(b));
+        !self.start.is_empty() && self.partners(a as usize).binary_search(&b).is_ok()
     }
 
     /// How many triangle pairs are watched.
     #[cfg(test)]
     pub(crate) fn len(&self) -> usize {
-        self.pairs.len()
+        self.partners.len()
     }
 }
 

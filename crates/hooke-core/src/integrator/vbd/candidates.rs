@@ -28,15 +28,62 @@ use rayon::prelude::*;
 /// The skin of a build, as a share of the reach it serves.
 pub(in crate::integrator) const SKIN: f64 = 1.0;
 
-/// One listed pair: its two primitives (a particle and a triangle, or two edges), and the
-/// distance at its last exact test plus its particles' travel summed then. One number
-/// for both keeps a pair in 16 bytes: the list is block descent's largest structure
-/// (two million pairs on the flat 128² cloth).
+/// One part of the list: its pairs in the search's order, in runs that share their first
+/// primitive (a particle, or an edge), each pair as its second primitive (a triangle, or an
+/// earlier edge) and its bound: the distance at its last exact test plus its particles'
+/// travel summed then, rounded down to single precision. The list is block descent's
+/// largest structure (1.3 million pairs on the flat 128² cloth): a pair takes 8 bytes, and
+/// a run (some twenty pairs) 8 more.
+#[derive(Clone, Debug, Default)]
+pub(in crate::integrator) struct Part {
+    /// Per run: its first primitive, and where its pairs end in `pairs`.
+    runs: Vec<(u32, u32)>,
+    pairs: Vec<Listed>,
+}
+
+/// A listed pair's second primitive and bound (see [`Part`]).
 #[derive(Clone, Copy, Debug)]
-pub(in crate::integrator) struct Candidate {
-    pub(in crate::integrator) a: u32,
-    pub(in crate::integrator) b: u32,
-    bound: f64,
+struct Listed {
+    b: u32,
+    bound: f32,
+}
+
+/// `x` rounded down to single precision: a bound that is never above what it stands for,
+/// so that every skip it proves is one the double-precision sum would prove.
+fn down(x: f64) -> f32 {
+    let f = x as f32;
+    if f64::from(f) > x { f.next_down() } else { f }
+}
+
+impl Part {
+    /// Appends pair `(a, b)` at bound `bound`.
+    fn push(&mut self, a: u32, b: u32, bound: f64) {
+        match self.runs.last_mut() {
+            Some((first, end)) if *first == a => *end += 1,
+            _ => self.runs.push((a, self.pairs.len() as u32 + 1)),
+        }
+        self.pairs.push(Listed {
+            b,
+            bound: down(bound),
+        });
+    }
+
+    /// Drops the slack of the part's growth: the parts are the pair list's memory.
+    fn shrink(&mut self) {
+        self.runs.shrink_to_fit();
+        self.pairs.shrink_to_fit();
+    }
+
+    /// The pairs as `(a, b, bound)`, in order.
+    #[cfg(test)]
+    fn iter(&self) -> impl Iterator<Item = (u32, u32, f32)> + '_ {
+        let mut begin = 0;
+        self.runs.iter().flat_map(move |&(a, end)| {
+            let run = &self.pairs[begin as usize..end as usize];
+            begin = end;
+            run.iter().map(move |p| (a, p.b, p.bound))
+        })
+    }
 }
 
 /// Rounding allowed for in a pair's bound, relative to it: `bound - travel` is the
@@ -58,8 +105,8 @@ pub(in crate::integrator) struct Candidates {
     last: Vec<Vec3>,
     last_mean: Vec3,
     /// The pairs in parts of the build's search, in its order.
-    point_tri: Vec<Vec<Candidate>>,
-    edge_edge: Vec<Vec<Candidate>>,
+    point_tri: Vec<Part>,
+    edge_edge: Vec<Part>,
 }
 
 /// The mean of the surface particles' positions (zero without any).
@@ -119,8 +166,8 @@ impl Candidates {
     pub(in crate::integrator) fn rebuild(
         &mut self,
         built: f64,
-        point_tri: Vec<Vec<Candidate>>,
-        edge_edge: Vec<Vec<Candidate>>,
+        point_tri: Vec<Part>,
+        edge_edge: Vec<Part>,
     ) {
         self.built = built;
         self.valid = true;
@@ -145,52 +192,57 @@ impl Candidates {
         let points = check(
             &mut self.point_tri,
             reach,
-            |c| {
-                let (tri, _) = topo.triangles[c.b as usize];
-                travel[c.a as usize] + tri.iter().map(|&i| travel[i as usize]).sum::<f64>()
+            |a, b| {
+                let (tri, _) = topo.triangles[b as usize];
+                travel[a as usize] + tri.iter().map(|&i| travel[i as usize]).sum::<f64>()
             },
-            |c| {
-                let (tri, _) = topo.triangles[c.b as usize];
-                point_triangle_distance(&x[c.a as usize], tri.map(|i| &x[i as usize]))
+            |a, b| {
+                let (tri, _) = topo.triangles[b as usize];
+                point_triangle_distance(&x[a as usize], tri.map(|i| &x[i as usize]))
             },
         );
-        let ends = |c: &Candidate| {
-            let ([a, b], _) = topo.edges[c.a as usize];
-            let ([e, f], _) = topo.edges[c.b as usize];
-            [a, b, e, f]
+        let ends = |e: u32, f: u32| {
+            let ([a, b], _) = topo.edges[e as usize];
+            let ([c, d], _) = topo.edges[f as usize];
+            [a, b, c, d]
         };
         let edges = check(
             &mut self.edge_edge,
             reach,
-            |c| ends(c).iter().map(|&i| travel[i as usize]).sum::<f64>(),
-            |c| segment_distance(ends(c).map(|i| &x[i as usize])),
+            |e, f| ends(e, f).iter().map(|&i| travel[i as usize]).sum::<f64>(),
+            |e, f| segment_distance(ends(e, f).map(|i| &x[i as usize])),
         );
         (points, edges)
     }
 }
 
-/// Checks the candidates, a part at a time in parallel: each whose budget (its particles'
-/// travel summed now, `travel`) does not keep it beyond `reach` is measured (`measure`), and
-/// returned when within it. Results in list order.
+/// Checks the listed pairs `(a, b)`, a part at a time in parallel: each whose budget (its
+/// particles' travel summed now, `travel`) does not keep it beyond `reach` is measured
+/// (`measure`), and returned when within it. Results in list order.
 fn check(
-    list: &mut [Vec<Candidate>],
+    list: &mut [Part],
     reach: f64,
-    travel: impl Fn(&Candidate) -> f64 + Sync,
-    measure: impl Fn(&Candidate) -> f64 + Sync,
+    travel: impl Fn(u32, u32) -> f64 + Sync,
+    measure: impl Fn(u32, u32) -> f64 + Sync,
 ) -> Vec<(u32, u32, f64)> {
-    let run = |part: &mut Vec<Candidate>| {
+    let run = |part: &mut Part| {
         let mut out = Vec::new();
-        for c in part {
-            let t = travel(c);
-            // The distance less the travel since its test, by the triangle inequality.
-            if c.bound - t >= reach + ROUNDING * c.bound {
-                continue;
+        let mut begin = 0;
+        for &(a, end) in &part.runs {
+            for c in &mut part.pairs[begin as usize..end as usize] {
+                let t = travel(a, c.b);
+                let bound = f64::from(c.bound);
+                // The distance less the travel since its test, by the triangle inequality.
+                if bound - t >= reach + ROUNDING * bound {
+                    continue;
+                }
+                let distance = measure(a, c.b);
+                c.bound = down(distance + t);
+                if distance < reach {
+                    out.push((a, c.b, distance));
+                }
             }
-            let distance = measure(c);
-            c.bound = distance + t;
-            if distance < reach {
-                out.push((c.a, c.b, distance));
-            }
+            begin = end;
         }
         out
     };
@@ -202,27 +254,39 @@ fn check(
 
 /// Every point–triangle pair (a surface particle, a triangle not holding it) and edge–edge
 /// pair (sharing no particle; each unordered pair once) of the surfaces within `reach` at
-/// `x` that `skip` does not hold apart, measured, through the grids' search.
+/// `x` that `skip` does not hold apart, measured, through the grids' search. Each search's
+/// grid and boxes go before the next is made: with the list being built, they were a
+/// build's peak memory.
 pub(in crate::integrator) fn search(
     (topo, skip): (&Topology, &Exclusion),
     x: &[Vec3],
     reach: f64,
-    (triangle_grid, edge_grid): (&mut Grid, &mut Grid),
-) -> (Vec<Vec<Candidate>>, Vec<Vec<Candidate>>) {
+) -> (Vec<Part>, Vec<Part>) {
+    let point_tri = point_triangle_pairs((topo, skip), x, reach);
+    (point_tri, edge_pairs((topo, skip), x, reach))
+}
+
+/// The point–triangle pairs of [`search`].
+fn point_triangle_pairs(
+    (topo, skip): (&Topology, &Exclusion),
+    x: &[Vec3],
+    reach: f64,
+) -> Vec<Part> {
+    let mut triangle_grid = Grid::default();
     let tri_boxes: Vec<(Vec3, Vec3)> = topo
         .triangles
         .iter()
         .map(|(t, _)| bounds_of(&t.map(|i| &x[i as usize]).each_ref().map(|p| *p)))
         .collect();
-    bin(triangle_grid, &tri_boxes, reach);
-    let grid = &*triangle_grid;
+    bin(&mut triangle_grid, &tri_boxes, reach);
+    let grid = &triangle_grid;
     let at: Vec<Cell> = x.iter().map(|p| grid.cell_of(p)).collect();
     let point = |v: usize| (x[v], x[v]);
-    let point_tri = by_cell(
+    by_cell(
         grid,
         &at,
         (&point, &tri_boxes, reach),
-        |v, candidates, out| {
+        |v, candidates, out: &mut Part| {
             if topo.surface[v] == u16::MAX {
                 return;
             }
@@ -237,15 +301,17 @@ pub(in crate::integrator) fn search(
                 }
                 let d = point_triangle_distance(p, tri.map(|i| &x[i as usize]));
                 if d < reach {
-                    out.push(Candidate {
-                        a: v as u32,
-                        b: t,
-                        bound: d,
-                    });
+                    out.push(v as u32, t, d);
                 }
             }
         },
-    );
+        Part::shrink,
+    )
+}
+
+/// The edge–edge pairs of [`search`].
+fn edge_pairs((topo, skip): (&Topology, &Exclusion), x: &[Vec3], reach: f64) -> Vec<Part> {
+    let mut edge_grid = Grid::default();
     let edge_boxes: Vec<(Vec3, Vec3)> = topo
         .edges
         .iter()
@@ -256,15 +322,15 @@ pub(in crate::integrator) fn search(
             )
         })
         .collect();
-    bin(edge_grid, &edge_boxes, reach);
-    let grid = &*edge_grid;
+    bin(&mut edge_grid, &edge_boxes, reach);
+    let grid = &edge_grid;
     let at: Vec<Cell> = edge_boxes.iter().map(|(lo, _)| grid.cell_of(lo)).collect();
     let edge = |e: usize| edge_boxes[e];
-    let edge_edge = by_cell(
+    by_cell(
         grid,
         &at,
         (&edge, &edge_boxes, reach),
-        |e, candidates, out| {
+        |e, candidates, out: &mut Part| {
             let ([a, b], _) = topo.edges[e];
             let bx = &edge_boxes[e];
             for &f in candidates {
@@ -282,16 +348,12 @@ pub(in crate::integrator) fn search(
                 }
                 let d = segment_distance([a, b, c0, d0].map(|i| &x[i as usize]));
                 if d < reach {
-                    out.push(Candidate {
-                        a: e as u32,
-                        b: f as u32,
-                        bound: d,
-                    });
+                    out.push(e as u32, f as u32, d);
                 }
             }
         },
-    );
-    (point_tri, edge_edge)
+        Part::shrink,
+    )
 }
 
 #[cfg(test)]
@@ -357,12 +419,7 @@ mod tests {
         let (model, x) = folded_sheet();
         let topo = Topology::new(&model, x.len());
         let reach = 0.013;
-        let (point_tri, edge_edge) = search(
-            (&topo, &Exclusion::default()),
-            &x,
-            reach,
-            (&mut Grid::default(), &mut Grid::default()),
-        );
+        let (point_tri, edge_edge) = search((&topo, &Exclusion::default()), &x, reach);
         let mut want_points = Vec::new();
         for v in 0..x.len() {
             for (t, (tri, _)) in topo.triangles.iter().enumerate() {
@@ -371,7 +428,7 @@ mod tests {
                 }
                 let d = point_triangle_distance(&x[v], tri.map(|i| &x[i as usize]));
                 if d < reach {
-                    want_points.push((v as u32, t as u32, d.to_bits()));
+                    want_points.push((v as u32, t as u32, down(d).to_bits()));
                 }
             }
         }
@@ -383,15 +440,15 @@ mod tests {
                 }
                 let dist = segment_distance([a, b, c, d].map(|&i| &x[i as usize]));
                 if dist < reach {
-                    want_edges.push((e as u32, f as u32, dist.to_bits()));
+                    want_edges.push((e as u32, f as u32, down(dist).to_bits()));
                 }
             }
         }
-        let found = |list: &[Vec<Candidate>]| {
+        let found = |list: &[Part]| {
             let mut v: Vec<_> = list
                 .iter()
-                .flatten()
-                .map(|c| (c.a, c.b, c.bound.to_bits()))
+                .flat_map(Part::iter)
+                .map(|(a, b, bound)| (a, b, bound.to_bits()))
                 .collect();
             v.sort_unstable();
             v
@@ -402,5 +459,17 @@ mod tests {
         assert!(want_points.len() > 1000 && want_edges.len() > 1000);
         assert_eq!(found(&point_tri), want_points);
         assert_eq!(found(&edge_edge), want_edges);
+    }
+
+    /// A bound rounded to single precision is never above the double it stands for, and
+    /// within one unit in the last place below it.
+    #[test]
+    fn a_bound_is_rounded_down() {
+        for x in [0.0, 1e-9, 0.0094, 0.1 + 0.2, 1.0 / 3.0, 7.3e-3, 1e30, 1e300] {
+            let f = down(x);
+            assert!(f64::from(f) <= x, "{x}");
+            assert!(f64::from(f.next_up()) > x, "{x}");
+        }
+        assert_eq!(down(0.5), 0.5);
     }
 }

@@ -17,35 +17,18 @@ pub(in crate::integrator) type QueryBox<'a> = dyn Fn(usize) -> Aabb + Sync + 'a;
 /// Queries (or primitives) per parallel chunk.
 const CHUNK: usize = 512;
 
-/// `f` over fixed chunks of `0..n` in parallel, results concatenated in chunk order.
-pub(in crate::integrator) fn chunked<T: Send>(
+/// `f` over fixed chunks of `0..n`, in parallel when there are several, each chunk's result
+/// in chunk order.
+pub(in crate::integrator) fn per_chunk<R: Send>(
     n: usize,
-    f: impl Fn(Range<usize>) -> Vec<T> + Sync + Send,
-) -> Vec<T> {
-    // One chunk is its own result: no copy of it.
-    if n <= CHUNK {
-        return f(0..n);
-    }
-    concatenate(parts(n, f))
-}
-
-/// `f` over fixed chunks of `0..n` in parallel, each chunk's results as one part, in chunk
-/// order: read end to end, they are [`chunked`]'s without a copy of them all.
-pub(in crate::integrator) fn parts<T: Send>(
-    n: usize,
-    f: impl Fn(Range<usize>) -> Vec<T> + Sync + Send,
-) -> Vec<Vec<T>> {
+    f: impl Fn(Range<usize>) -> R + Sync + Send,
+) -> Vec<R> {
     if n <= CHUNK {
         return vec![f(0..n)];
     }
     (0..n.div_ceil(CHUNK))
         .into_par_iter()
-        .map(|c| {
-            let mut part = f(c * CHUNK..((c + 1) * CHUNK).min(n));
-            // Without its growth's slack: the parts are the pair list's memory.
-            part.shrink_to_fit();
-            part
-        })
+        .map(|c| f(c * CHUNK..((c + 1) * CHUNK).min(n)))
         .collect()
 }
 
@@ -93,19 +76,21 @@ pub(in crate::integrator) fn bin(grid: &mut Grid, boxes: &[(Vec3, Vec3)], reach:
 /// Calls `test(q, candidates, out)` for every query `q` whose cell is `cells[q]`, with the
 /// items of the 27 cells around that cell (every item whose low corner lies within one cell
 /// of the query's), gathered once per occupied cell. Results come in the order of (cell,
-/// query), in parts of consecutive cells ([`parts`]): fixed by the positions alone, never by
+/// query), in parts of consecutive cells, each part `finish`ed as soon as it is whole (so
+/// that its slack goes before the next is grown): fixed by the positions alone, never by
 /// threads.
 ///
 /// `boxes` (each query's box, each item's box, the reach) prunes a cell's items to those
 /// whose box comes within the reach of its queries' joint box (by a nanometre more, so
 /// that rounding never drops one a query's own box test would keep): the same items reach
 /// `test`, in the same order, fewer of those that none of the cell's queries can meet.
-pub(in crate::integrator) fn by_cell<T: Send>(
+pub(in crate::integrator) fn by_cell<P: Default + Send>(
     grid: &Grid,
     cells: &[Cell],
     boxes: (&QueryBox<'_>, &[Aabb], f64),
-    test: impl Fn(usize, &[u32], &mut Vec<T>) + Sync + Send,
-) -> Vec<Vec<T>> {
+    test: impl Fn(usize, &[u32], &mut P) + Sync + Send,
+    finish: impl Fn(&mut P) + Sync + Send,
+) -> Vec<P> {
     let (query_box, item_boxes, reach) = boxes;
     let pad = reach + 1e-9;
     let mut order: Vec<u32> = (0..cells.len() as u32).collect();
@@ -114,8 +99,8 @@ pub(in crate::integrator) fn by_cell<T: Send>(
         .filter(|&k| k == 0 || cells[order[k] as usize] != cells[order[k - 1] as usize])
         .collect();
     starts.push(order.len());
-    parts(starts.len() - 1, |groups| {
-        let mut out = Vec::new();
+    per_chunk(starts.len() - 1, |groups| {
+        let mut out = P::default();
         let mut candidates = Vec::new();
         for g in groups {
             let members = &order[starts[g]..starts[g + 1]];
@@ -141,6 +126,7 @@ pub(in crate::integrator) fn by_cell<T: Send>(
                 test(q as usize, &candidates, &mut out);
             }
         }
+        finish(&mut out);
         out
     })
 }

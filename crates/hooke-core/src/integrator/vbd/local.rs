@@ -319,7 +319,7 @@ impl Local<'_> {
     /// Particle `i`'s energy against the colliders it touches, at `xi` with its friction's
     /// normal force lagged at `base` (see [`Local::energy`]).
     fn collider_energy(&self, i: usize, (xi, base): (&Vec3, &Vec3), moved: Vec3) -> f64 {
-        let touches = self.detection.touches[i].planes();
+        let touches = self.detection.touches.of(i);
         let dt = self.dt;
         let mut e = 0.0;
         for plane in touches {
@@ -435,7 +435,7 @@ impl Local<'_> {
     }
 
     fn colliders(&self, i: usize, xi: &Vec3, moved: Vec3, b: &mut Block, gaps: &mut impl GapSink) {
-        let touches = self.detection.touches[i].planes();
+        let touches = self.detection.touches.of(i);
         if touches.is_empty() {
             return;
         }

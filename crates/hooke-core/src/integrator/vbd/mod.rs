@@ -508,7 +508,7 @@ pub(in crate::integrator) fn clip(
     // deep is lifted back along the plane's normal, keeping its sliding, when that stays in
     // the ball and keeps every half-space; otherwise it is taken back along the segment
     // from the centre, which keeps them all.
-    let halves = &detection.halves[i];
+    let halves = detection.halves.of(i);
     let floor = |d: f64| (1.0 - detect::GAMMA_COLLIDER) * d;
     let depth =
         |y: &Vec3, &(point, normal, d): &(Vec3, Vec3, f64)| floor(d) - normal.dot(&(y - point));

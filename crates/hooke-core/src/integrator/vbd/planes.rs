@@ -1,4 +1,5 @@
-//! Colliders as a particle sees them between detections: tangent planes.
+//! Colliders as a particle sees them between detections: tangent planes, gathered per
+//! particle at a detection and kept in [`Lists`].
 
 use crate::particles::Vec3;
 
@@ -95,7 +96,93 @@ impl HalfSpaces {
     }
 
     /// `(point, normal, gap)` of each plane kept.
-    pub(in crate::integrator) fn iter(&self) -> impl Iterator<Item = &(Vec3, Vec3, f64)> {
-        self.planes[..self.count as usize].iter()
+    pub(in crate::integrator) fn planes(&self) -> &[(Vec3, Vec3, f64)] {
+        &self.planes[..self.count as usize]
+    }
+}
+
+/// A list per particle, end to end in one array: most particles touch no collider, and a
+/// fixed room for the most any may keep took 380 bytes a particle (6 MB on the 128² cloth).
+#[derive(Clone, Debug)]
+pub(in crate::integrator) struct Lists<T> {
+    /// List `i` is `items[start[i]..start[i + 1]]`.
+    start: Vec<u32>,
+    items: Vec<T>,
+}
+
+impl<T> Default for Lists<T> {
+    fn default() -> Self {
+        Self {
+            start: vec![0],
+            items: Vec::new(),
+        }
+    }
+}
+
+impl<T: Copy> Lists<T> {
+    /// List `i`.
+    #[inline]
+    pub(in crate::integrator) fn of(&self, i: usize) -> &[T] {
+        &self.items[self.start[i] as usize..self.start[i + 1] as usize]
+    }
+
+    /// Whether list `i` is empty.
+    #[inline]
+    pub(in crate::integrator) fn is_empty_at(&self, i: usize) -> bool {
+        self.start[i] == self.start[i + 1]
+    }
+
+    /// No lists.
+    pub(in crate::integrator) fn clear(&mut self) {
+        self.start.clear();
+        self.start.push(0);
+        self.items.clear();
+    }
+
+    /// Appends `list` as the next one.
+    pub(in crate::integrator) fn push(&mut self, list: &[T]) {
+        self.items.extend_from_slice(list);
+        self.start.push(self.items.len() as u32);
+    }
+
+    /// Appends `other`'s lists after these, in their order.
+    pub(in crate::integrator) fn append(&mut self, other: &Self) {
+        let base = self.items.len() as u32;
+        self.items.extend_from_slice(&other.items);
+        self.start.extend(other.start[1..].iter().map(|s| base + s));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Lists pushed one by one, or in two runs appended, read back as they were given,
+    /// empty ones included: what the detection's chunks rely on.
+    #[test]
+    fn lists_appended_in_parts_read_as_pushed() {
+        let given: [&[u32]; 5] = [&[], &[7, 8], &[], &[1], &[4, 5, 6]];
+        let mut whole = Lists::default();
+        for list in given {
+            whole.push(list);
+        }
+        let (mut first, mut second) = (Lists::default(), Lists::default());
+        for list in &given[..2] {
+            first.push(list);
+        }
+        for list in &given[2..] {
+            second.push(list);
+        }
+        let mut joined = Lists::default();
+        joined.append(&first);
+        joined.append(&second);
+        for (i, list) in given.iter().enumerate() {
+            assert_eq!(whole.of(i), *list);
+            assert_eq!(joined.of(i), *list);
+            assert_eq!(joined.is_empty_at(i), list.is_empty());
+        }
+        joined.clear();
+        joined.push(&[3]);
+        assert_eq!(joined.of(0), &[3]);
     }
 }

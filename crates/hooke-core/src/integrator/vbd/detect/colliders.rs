@@ -2,15 +2,14 @@
 //! may touch, per surface triangle the nearest sharp feature and the feature pairs
 //! (docs/physics.md §4.1).
 
-use super::{CHUNK, CONTACT_STIFFNESS, Clearance, Detection, FELT};
+use super::{CONTACT_STIFFNESS, Clearance, Detection, FELT};
 use crate::collider::response::Response;
 use crate::contact::proximity::feature_triangle;
-use crate::integrator::vbd::cells::{bounds_of, chunked};
+use crate::integrator::vbd::cells::{bounds_of, per_chunk};
 use crate::integrator::vbd::pairs::{Pair, Sides};
-use crate::integrator::vbd::planes::{HalfSpaces, Plane, Touches};
+use crate::integrator::vbd::planes::{HalfSpaces, Lists, Plane, Touches};
 use crate::model::Model;
 use crate::particles::Vec3;
-use rayon::prelude::*;
 
 /// The normal stiffness and Coulomb coefficient a collider's response gives a contact with
 /// stiffness scale `scale`.
@@ -22,20 +21,24 @@ pub(in crate::integrator) fn collider_law(response: &Response, scale: f64) -> (f
     }
 }
 
+/// What a chunk of particles' collider search found, per particle in order.
+#[derive(Default)]
+struct Found {
+    clearances: Vec<Clearance>,
+    touches: Lists<Plane>,
+    halves: Lists<(Vec3, Vec3, f64)>,
+}
+
 impl Detection {
     /// Per particle: the nearest collider surface (capped at `reach`) and which colliders
     /// it may touch before the next detection.
     pub(super) fn detect_colliders(&mut self, model: &Model, x: &[Vec3], reach: f64) {
         let topology = &self.topology;
-        let n = x.len();
-        self.point_collider.resize(n, Clearance::new(reach));
-        self.touches.resize(n, Touches::default());
-        self.halves.resize(n, HalfSpaces::default());
-        let one = |i: usize, (clearance, near, halves): (&mut Clearance, &mut Touches, &mut HalfSpaces)| {
+        let one = |i: usize, found: &mut Found| {
             let (lo, hi) = (x[i].add_scalar(-reach), x[i].add_scalar(reach));
-            *clearance = Clearance::new(reach);
-            *near = Touches::default();
-            *halves = HalfSpaces::default();
+            let mut clearance = Clearance::new(reach);
+            let mut near = Touches::default();
+            let mut halves = HalfSpaces::default();
             for (k, slot) in model.colliders.iter().enumerate() {
                 if !slot.shape.may_touch(&lo, &hi, 0.0) {
                     continue;
@@ -66,27 +69,24 @@ impl Detection {
                     }
                 });
             }
+            found.clearances.push(clearance);
+            found.touches.push(near.planes());
+            found.halves.push(halves.planes());
         };
-        let (clearances, near, halves) = (
-            &mut self.point_collider,
-            &mut self.touches,
-            &mut self.halves,
-        );
-        if n <= CHUNK {
-            for i in 0..n {
-                one(i, (&mut clearances[i], &mut near[i], &mut halves[i]));
+        let found = per_chunk(x.len(), |range| {
+            let mut found = Found::default();
+            for i in range {
+                one(i, &mut found);
             }
-        } else {
-            clearances
-                .par_chunks_mut(CHUNK)
-                .zip(near.par_chunks_mut(CHUNK))
-                .zip(halves.par_chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(|(c, ((cl, ne), ha))| {
-                    for k in 0..cl.len() {
-                        one(c * CHUNK + k, (&mut cl[k], &mut ne[k], &mut ha[k]));
-                    }
-                });
+            found
+        });
+        self.point_collider.clear();
+        self.touches.clear();
+        self.halves.clear();
+        for part in &found {
+            self.point_collider.extend_from_slice(&part.clearances);
+            self.touches.append(&part.touches);
+            self.halves.append(&part.halves);
         }
     }
 
@@ -104,8 +104,9 @@ impl Detection {
         }
         let scale = &self.scale;
         let (points, touches) = (&self.point_collider, &self.touches);
-        let found = chunked(triangles.len(), |range| {
-            let mut out = Vec::new();
+        // Per chunk: each triangle's clearance, and the chunk's pairs in triangle order.
+        let found = per_chunk(triangles.len(), |range| {
+            let (mut clearances, mut pairs) = (Vec::with_capacity(range.len()), Vec::new());
             for t in range {
                 let (tri, s) = triangles[t];
                 let [a, b, c] = tri.map(|i| &x[i as usize]);
@@ -122,12 +123,11 @@ impl Detection {
                     .map(|&i| points[i as usize].nearest)
                     .fold(0.0, f64::max);
                 let size = (a - b).norm().max((b - c).norm()).max((c - a).norm());
-                let felt = tri.iter().any(|&i| touches[i as usize].count != 0);
+                let felt = tri.iter().any(|&i| !touches.is_empty_at(i as usize));
                 if !felt && nearest - size >= reach {
-                    out.push((t, clearance, Vec::new()));
+                    clearances.push(clearance);
                     continue;
                 }
-                let mut pairs = Vec::new();
                 for slot in model.colliders.iter().filter(|c| c.shape.has_features()) {
                     let (k, mu) = collider_law(
                         &slot.response,
@@ -161,13 +161,14 @@ impl Detection {
                             }
                         });
                 }
-                out.push((t, clearance, pairs));
+                clearances.push(clearance);
             }
-            out
+            (clearances, pairs)
         });
-        for (t, d, pairs) in found {
-            self.triangle_collider[t] = d;
-            self.pairs.extend(pairs);
+        self.triangle_collider.clear();
+        for (clearances, pairs) in found {
+            self.triangle_collider.extend_from_slice(&clearances);
+            self.pairs.extend_from_slice(&pairs);
         }
     }
 }

@@ -27,11 +27,10 @@ pub(in crate::integrator) use colliders::collider_law;
 use super::candidates::{Candidates, SKIN, search};
 use super::graph::Graph;
 use super::pairs::{Pair, Sides, stencil_distance};
-use super::planes::{HalfSpaces, Touches};
+use super::planes::{Lists, Plane};
 use super::topology::Topology;
 use crate::collider::response::Response;
 use crate::contact::exclusion::Exclusion;
-use crate::contact::grid::Grid;
 use crate::model::Model;
 use crate::particles::{Particles, Vec3};
 
@@ -51,8 +50,6 @@ const COLLIDER_REACH: f64 = 10.0;
 const FELT: f64 = 2.0;
 /// Contact stiffness as a multiple of a particle's own stiffness scale `m/dt² + Σ ks`.
 pub(crate) const CONTACT_STIFFNESS: f64 = 1.0;
-/// Particles (or triangles, edges) per parallel chunk of the detection.
-const CHUNK: usize = 512;
 
 /// How near a primitive's nearest neighbour is, and its nearest neighbour whose contact is
 /// not felt (farther than [`FELT`] thicknesses), capped at the search's reach.
@@ -109,8 +106,6 @@ fn per_particle(
 #[derive(Clone, Debug, Default)]
 pub(in crate::integrator) struct Detection {
     topology: Topology,
-    triangle_grid: Grid,
-    edge_grid: Grid,
     /// Positions at the first step: pairs nearer than their gap there are neighbours in the
     /// body's own rest shape, not contacts.
     rest: Vec<Vec3>,
@@ -118,10 +113,10 @@ pub(in crate::integrator) struct Detection {
     exclusion: Exclusion,
     /// Per particle: the collider surfaces it may reach before the next detection, each as
     /// its tangent plane at the detection.
-    pub(in crate::integrator) touches: Vec<Touches>,
+    pub(in crate::integrator) touches: Lists<Plane>,
     /// Per particle: the half-space colliders near it, which bound only the motion that
     /// closes its gap to them.
-    pub(in crate::integrator) halves: Vec<HalfSpaces>,
+    pub(in crate::integrator) halves: Lists<(Vec3, Vec3, f64)>,
     /// Surface pairs and feature pairs within reach.
     pub(in crate::integrator) pairs: Vec<Pair>,
     /// Per free body of the graph: whether a surface pair joins it to another body (then
@@ -241,7 +236,7 @@ impl Detection {
     /// Whether particle `i` may feel a contact before the next detection.
     #[inline]
     pub(in crate::integrator) fn may_touch(&self, i: usize) -> bool {
-        self.touches[i].count != 0 || self.start[i] != self.start[i + 1]
+        !self.touches.is_empty_at(i) || self.start[i] != self.start[i + 1]
     }
 
     /// The thickness particle `i` keeps from penalty colliders: its surface's.
@@ -355,23 +350,15 @@ impl Detection {
             // block-descent step's peak memory.
             self.candidates.forget();
             let built = reach + SKIN * reach;
-            let (point_tri, edge_edge) = search(
-                (topo, &self.exclusion),
-                x,
-                built,
-                (&mut self.triangle_grid, &mut self.edge_grid),
-            );
+            let (point_tri, edge_edge) = search((topo, &self.exclusion), x, built);
             self.candidates.rebuild(built, point_tri, edge_edge);
         }
         let (found, found_edges) = self.candidates.within(topo, x, reach);
-        let found: Vec<_> = found
-            .into_iter()
-            .filter_map(|(v, t, d)| {
-                let law = law(topo.surface[v as usize], topo.triangles[t as usize].1)?;
-                Some((v as usize, t, d, law.0, law.1))
-            })
-            .collect();
-        for (v, t, d, h, mu) in found {
+        for (v, t, d) in found {
+            let Some((h, mu)) = law(topo.surface[v as usize], topo.triangles[t as usize].1) else {
+                continue;
+            };
+            let v = v as usize;
             let tri = topo.triangles[t as usize].0;
             let felt = d <= FELT * h;
             // The pair's distance less what its keyed pins move apart from the shared
@@ -399,14 +386,11 @@ impl Detection {
             }
         }
 
-        let found: Vec<_> = found_edges
-            .into_iter()
-            .filter_map(|(e, f, d)| {
-                let law = law(topo.edges[e as usize].1, topo.edges[f as usize].1)?;
-                Some((e as usize, f as usize, d, law.0, law.1))
-            })
-            .collect();
-        for (e, f, d, h, mu) in found {
+        for (e, f, d) in found_edges {
+            let Some((h, mu)) = law(topo.edges[e as usize].1, topo.edges[f as usize].1) else {
+                continue;
+            };
+            let (e, f) = (e as usize, f as usize);
             let felt = d <= FELT * h;
             let ([a, b], _) = topo.edges[e];
             let ([c, dd], _) = topo.edges[f];
@@ -516,7 +500,7 @@ impl Detection {
         // lying on a plane shifts along it: the part of `u` into a plane it would close
         // too far is taken out (in particle order), so it slides as a whole.
         for i in (0..n).filter(|&i| self.shifted[i]) {
-            for &(_, normal, d) in self.halves[i].iter() {
+            for &(_, normal, d) in self.halves.of(i) {
                 let into = -normal.dot(&u);
                 if into > 0.5 * GAMMA_COLLIDER * d {
                     u += normal * into;
@@ -524,7 +508,8 @@ impl Detection {
             }
         }
         let closes_half = (0..n).filter(|&i| self.shifted[i]).any(|i| {
-            self.halves[i]
+            self.halves
+                .of(i)
                 .iter()
                 .any(|&(_, normal, d)| -normal.dot(&u) > 0.5 * GAMMA_COLLIDER * d)
         });
