@@ -249,10 +249,11 @@ fn assemble(local: &Local<'_>, x: &[Vec3], nb: &mut NewtonBuffers) {
                     Sym3::default()
                 } else {
                     let u = d / len;
+                    let (ks, kd) = graph.law(s);
                     let transverse = (1.0 - s.rest / len).max(0.0);
                     Sym3::outer(&u)
-                        .scale(s.ks * (1.0 - transverse) + s.kd / dt)
-                        .plus_identity(s.ks * transverse)
+                        .scale(ks * (1.0 - transverse) + kd / dt)
+                        .plus_identity(ks * transverse)
                 });
         }
     }

@@ -4,14 +4,15 @@
 use crate::model::Model;
 use crate::particles::Particles;
 
-/// One spring seen from one of its ends.
+/// One spring seen from one of its ends: 16 bytes, its coefficients shared with every
+/// spring that has the same (a cloth's springs come in a few kinds).
 #[derive(Clone, Copy, Debug)]
 pub(in crate::integrator) struct Neighbour {
     /// The particle at the other end.
     pub(in crate::integrator) other: u32,
+    /// Its `(ks, kd)` in the graph's table ([`Graph::law`]).
+    law: u32,
     pub(in crate::integrator) rest: f64,
-    pub(in crate::integrator) ks: f64,
-    pub(in crate::integrator) kd: f64,
 }
 
 /// Per-particle spring lists and the colouring, built once per model.
@@ -22,6 +23,8 @@ pub(in crate::integrator) struct Graph {
     /// Particle `i`'s neighbours are `neighbours[start[i]..start[i + 1]]`, in spring order.
     start: Vec<u32>,
     neighbours: Vec<Neighbour>,
+    /// The distinct `[ks, kd]` of the springs, in the order they first come.
+    laws: Vec<[f64; 2]>,
     /// The free (unpinned) particles of each colour, in increasing index.
     pub(in crate::integrator) colours: Vec<Vec<u32>>,
     /// Per particle: `m / dt²`-free stiffness scale, the sum of its springs' `ks`.
@@ -61,20 +64,25 @@ impl Graph {
         let mut cursor = start.clone();
         let empty = Neighbour {
             other: 0,
+            law: 0,
             rest: 0.0,
-            ks: 0.0,
-            kd: 0.0,
         };
         let mut neighbours = vec![empty; start[n] as usize];
         let mut stiffness = vec![0.0; n];
+        let (mut laws, mut index) = (Vec::new(), std::collections::HashMap::new());
         for s in &model.springs {
+            let law = *index
+                .entry([s.ks.to_bits(), s.kd.to_bits()])
+                .or_insert_with(|| {
+                    laws.push([s.ks, s.kd]);
+                    laws.len() as u32 - 1
+                });
             for (a, b) in [(s.i, s.j), (s.j, s.i)] {
                 let a = a as usize;
                 neighbours[cursor[a] as usize] = Neighbour {
                     other: b,
+                    law,
                     rest: s.rest,
-                    ks: s.ks,
-                    kd: s.kd,
                 };
                 cursor[a] += 1;
                 stiffness[a] += s.ks;
@@ -84,6 +92,7 @@ impl Graph {
             built_for: (n, model.springs.len()),
             start,
             neighbours,
+            laws,
             colours: Vec::new(),
             colouring: 0,
             stiffness,
@@ -157,6 +166,13 @@ impl Graph {
     #[inline]
     pub(in crate::integrator) fn of(&self, i: usize) -> &[Neighbour] {
         &self.neighbours[self.start[i] as usize..self.start[i + 1] as usize]
+    }
+
+    /// A neighbour's spring's stiffness and damping, `(ks, kd)`.
+    #[inline]
+    pub(in crate::integrator) fn law(&self, nb: &Neighbour) -> (f64, f64) {
+        let [ks, kd] = self.laws[nb.law as usize];
+        (ks, kd)
     }
 }
 

@@ -399,6 +399,7 @@ impl Local<'_> {
         let moved = xi - self.start[i];
         let mut b = self.inertia(i, x);
         for nb in self.graph.of(i) {
+            let (ks, kd) = self.graph.law(nb);
             let j = nb.other as usize;
             let d = xi - x[j];
             let len = d.norm();
@@ -407,14 +408,14 @@ impl Local<'_> {
             }
             let u = d / len;
             let rate = (moved - (x[j] - self.start[j])).dot(&u) / dt;
-            b.f -= u * (nb.ks * (len - nb.rest) + nb.kd * rate);
+            b.f -= u * (ks * (len - nb.rest) + kd * rate);
             // The transverse term is dropped for compressed springs, which keeps the block
             // positive definite (as the implicit integrator's, Choi & Ko 2002).
             let transverse = (1.0 - nb.rest / len).max(0.0);
             b.h = b.h.plus(
                 &Sym3::outer(&u)
-                    .scale(nb.ks * (1.0 - transverse) + nb.kd / dt)
-                    .plus_identity(nb.ks * transverse),
+                    .scale(ks * (1.0 - transverse) + kd / dt)
+                    .plus_identity(ks * transverse),
             );
         }
         b
