@@ -280,6 +280,9 @@ struct SceneFigures {
     contact_share: f64,
     /// Rebuilds of the contact candidate lists during the measured steps.
     contact_rebuilds: u64,
+    /// The process's peak resident memory, MiB (the scene's build included), where the
+    /// system says it (Linux).
+    peak_resident_mib: Option<f64>,
 }
 
 /// Block descent's wall time by what it did, seconds.
@@ -620,6 +623,7 @@ fn scene_steps(
         fastest_step_s: times.fastest(),
         contact_share: (contacts.seconds - contacts_before.seconds) / seconds,
         contact_rebuilds: contacts.rebuilds - contacts_before.rebuilds,
+        peak_resident_mib: crate::memory::peak_resident_mib(),
     };
     if json {
         println!("{}", serde_json::to_string(&figures)?);
@@ -627,7 +631,7 @@ fn scene_steps(
         println!(
             "{}: {} particles, {} springs, {steps} {} steps of {} s on {} ({} kernel, \
              {} batches, runs by {}) in {:.3} s: {:.0} steps/s (median step {:.1} µs, fastest {:.1} µs), {:.3} s per \
-             simulated second; contacts {:.0}% of the time ({} candidate rebuilds){}",
+             simulated second; contacts {:.0}% of the time ({} candidate rebuilds){}{}",
             figures.scene,
             figures.particles,
             figures.springs,
@@ -686,7 +690,10 @@ fn scene_steps(
                 )
             } else {
                 String::new()
-            }
+            },
+            figures
+                .peak_resident_mib
+                .map_or(String::new(), |m| format!("; peak resident {m:.1} MiB"))
         );
     }
     Ok(ExitCode::SUCCESS)

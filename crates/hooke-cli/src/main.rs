@@ -7,6 +7,7 @@ mod bench;
 mod check;
 mod convert;
 mod drape;
+mod memory;
 mod picture;
 mod report;
 mod risks;

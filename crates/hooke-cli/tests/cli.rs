@@ -458,6 +458,12 @@ fn bench_scene_times_a_large_step_run_from_its_start_and_says_how_well_it_solved
     }
     let residual = f["max_residual"].as_f64().unwrap();
     assert!(residual.is_finite() && residual >= 0.0, "{f}");
+    // The process's peak memory: at least the particles' positions and velocities, less
+    // than a cloth this size could need.
+    if cfg!(target_os = "linux") {
+        let mib = f["peak_resident_mib"].as_f64().unwrap();
+        assert!((1.0..2048.0).contains(&mib), "{f}");
+    }
     // An explicit scheme is timed after its warm-up and has no solver to cap.
     let f = json(&[
         "bench",
