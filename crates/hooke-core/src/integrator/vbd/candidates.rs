@@ -49,14 +49,24 @@ struct Listed {
 }
 
 /// `x` rounded down to single precision: a bound that is never above what it stands for,
-/// so that every skip it proves is one the double-precision sum would prove.
+/// so that every skip it proves is one the double-precision sum would prove. Without a
+/// branch: whether rounding to nearest went up is a coin toss, and a mispredicted branch
+/// per pair cost cloth-pile's detection a tenth of its time.
+#[inline]
 fn down(x: f64) -> f32 {
+    debug_assert!(
+        x >= 0.0 || x.is_nan(),
+        "bounds are distances plus travel: {x}"
+    );
     let f = x as f32;
-    if f64::from(f) > x { f.next_down() } else { f }
+    // One unit in the last place down when rounding went up (the largest finite float
+    // below infinity); never for a NaN, which compares false.
+    f32::from_bits(f.to_bits() - u32::from(f64::from(f) > x))
 }
 
 impl Part {
     /// Appends pair `(a, b)` at bound `bound`.
+    #[inline]
     fn push(&mut self, a: u32, b: u32, bound: f64) {
         match self.runs.last_mut() {
             Some((first, end)) if *first == a => *end += 1,
@@ -471,5 +481,7 @@ mod tests {
             assert!(f64::from(f.next_up()) > x, "{x}");
         }
         assert_eq!(down(0.5), 0.5);
+        assert_eq!(down(f64::INFINITY), f32::INFINITY);
+        assert!(down(f64::NAN).is_nan());
     }
 }

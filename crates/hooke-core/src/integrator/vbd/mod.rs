@@ -140,7 +140,7 @@ pub(in crate::integrator) fn step(
             target: &b.target,
             dt,
         };
-        b.lanes.follow(&b.graph, dt);
+        b.lanes.follow(&b.graph);
         for (c, colour) in b.graph.colours.iter().enumerate() {
             let (x, detected, detection, lanes) = (&p.x, &b.detected, &b.detection, &b.lanes);
             b.next.resize(colour.len(), (Vec3::zeros(), false));

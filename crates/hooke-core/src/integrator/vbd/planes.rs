@@ -20,7 +20,7 @@ const TOUCHES: usize = 4;
 /// The collider planes one particle may touch, nearest kept when there are more.
 #[derive(Clone, Copy, Debug)]
 pub(in crate::integrator) struct Touches {
-    pub(in crate::integrator) count: u8,
+    count: u8,
     planes: [Plane; TOUCHES],
     gaps: [f64; TOUCHES],
 }

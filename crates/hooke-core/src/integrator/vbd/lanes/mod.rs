@@ -45,9 +45,6 @@ struct Stream {
     rest: Vec<Row>,
     ks: Vec<Row>,
     kd: Vec<Row>,
-    /// Per row: `kd / dt` at the step the lanes were last laid out for (a division the
-    /// sum would otherwise make at every sweep; the same bits).
-    kd_dt: Vec<Row>,
 }
 
 /// A particle's first coordinate's index in its positions seen as `f64`s.
@@ -65,7 +62,6 @@ impl Stream {
         self.rest.clear();
         self.ks.clear();
         self.kd.clear();
-        self.kd_dt.clear();
         // The rows in one allocation each, of exactly their number: grown by doubling, four
         // of the five row arrays held 40 % slack (3.7 MB of the 128² cloth).
         let rows: usize = colour
@@ -105,44 +101,29 @@ impl Stream {
             }
         }
     }
-
-    /// Divides the damping coefficients by the step `dt`.
-    fn divide(&mut self, dt: f64) {
-        self.kd_dt.clear();
-        self.kd_dt
-            .extend(self.kd.iter().map(|kd| kd.map(|kd| kd / dt)));
-    }
 }
 
 /// Every colour's [`Stream`] for one colouring of the graph, laid out again when it is
 /// coloured anew (at a detection that found pairs).
 #[derive(Clone, Debug, Default)]
 pub(in crate::integrator) struct Lanes {
-    /// The colouring and step it was laid out for ([`Graph::colouring`]).
-    built_for: Option<(u64, f64)>,
+    /// The colouring it was laid out for ([`Graph::colouring`]).
+    built_for: Option<u64>,
     streams: Vec<Stream>,
 }
 
 impl Lanes {
-    /// Lays out `graph`'s colours for steps of `dt`, unless it already has this colouring
-    /// and step.
-    pub(in crate::integrator) fn follow(&mut self, graph: &Graph, dt: f64) {
-        match self.built_for {
-            Some((colouring, step)) if colouring == graph.colouring => {
-                if step.to_bits() != dt.to_bits() {
-                    self.streams.iter_mut().for_each(|s| s.divide(dt));
-                }
-            }
-            _ => {
-                self.streams
-                    .resize_with(graph.colours.len(), Stream::default);
-                for (stream, colour) in self.streams.iter_mut().zip(&graph.colours) {
-                    stream.fill(graph, colour);
-                    stream.divide(dt);
-                }
-            }
+    /// Lays out `graph`'s colours, unless it already has this colouring.
+    pub(in crate::integrator) fn follow(&mut self, graph: &Graph) {
+        if self.built_for == Some(graph.colouring) {
+            return;
         }
-        self.built_for = Some((graph.colouring, dt));
+        self.streams
+            .resize_with(graph.colours.len(), Stream::default);
+        for (stream, colour) in self.streams.iter_mut().zip(&graph.colours) {
+            stream.fill(graph, colour);
+        }
+        self.built_for = Some(graph.colouring);
     }
 
     /// The inertia, drag and springs of particles `ids` at positions `x`, the `block`-th
@@ -253,7 +234,7 @@ mod tests {
             dt: 1.0 / 60.0,
         };
         let mut lanes = Lanes::default();
-        lanes.follow(&graph, local.dt);
+        lanes.follow(&graph);
         let bits = |b: &Block| {
             let mut v: Vec<u64> = b.f.iter().map(|c| c.to_bits()).collect();
             v.extend(b.h.0.iter().map(|c| c.to_bits()));
