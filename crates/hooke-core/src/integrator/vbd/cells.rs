@@ -15,7 +15,7 @@ pub(in crate::integrator) type Aabb = (Vec3, Vec3);
 pub(in crate::integrator) type QueryBox<'a> = dyn Fn(usize) -> Aabb + Sync + 'a;
 
 /// Queries (or primitives) per parallel chunk.
-const CHUNK: usize = 512;
+pub(in crate::integrator) const CHUNK: usize = 512;
 
 /// `f` over fixed chunks of `0..n`, in parallel when there are several, each chunk's result
 /// in chunk order.

@@ -5,11 +5,12 @@
 use super::{CONTACT_STIFFNESS, Clearance, Detection, FELT};
 use crate::collider::response::Response;
 use crate::contact::proximity::feature_triangle;
-use crate::integrator::vbd::cells::{bounds_of, per_chunk};
+use crate::integrator::vbd::cells::{CHUNK, bounds_of, per_chunk};
 use crate::integrator::vbd::pairs::{Pair, Sides};
 use crate::integrator::vbd::planes::{HalfSpaces, Lists, Plane, Touches};
 use crate::model::Model;
 use crate::particles::Vec3;
+use rayon::prelude::*;
 
 /// The normal stiffness and Coulomb coefficient a collider's response gives a contact with
 /// stiffness scale `scale`.
@@ -21,9 +22,10 @@ pub(in crate::integrator) fn collider_law(response: &Response, scale: f64) -> (f
     }
 }
 
-/// What a chunk of particles' collider search found, per particle in order.
-#[derive(Default)]
-struct Found {
+/// What a chunk of particles' collider search found, per particle in order; kept between
+/// detections so that a detection allocates nothing once its buffers have grown.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Found {
     clearances: Vec<Clearance>,
     touches: Lists<Plane>,
     halves: Lists<(Vec3, Vec3, f64)>,
@@ -73,17 +75,29 @@ impl Detection {
             found.touches.push(near.planes());
             found.halves.push(halves.planes());
         };
-        let found = per_chunk(x.len(), |range| {
-            let mut found = Found::default();
-            for i in range {
-                one(i, &mut found);
+        let n = x.len();
+        let fill = |c: usize, found: &mut Found| {
+            found.clearances.clear();
+            found.touches.clear();
+            found.halves.clear();
+            for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                one(i, found);
             }
-            found
-        });
+        };
+        let chunks = &mut self.found;
+        chunks.resize_with(n.div_ceil(CHUNK).max(1), Found::default);
+        if chunks.len() == 1 {
+            fill(0, &mut chunks[0]);
+        } else {
+            chunks
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(c, found)| fill(c, found));
+        }
         self.point_collider.clear();
         self.touches.clear();
         self.halves.clear();
-        for part in &found {
+        for part in &self.found {
             self.point_collider.extend_from_slice(&part.clearances);
             self.touches.append(&part.touches);
             self.halves.append(&part.halves);

@@ -117,6 +117,8 @@ pub(in crate::integrator) struct Detection {
     /// Per particle: the half-space colliders near it, which bound only the motion that
     /// closes its gap to them.
     pub(in crate::integrator) halves: Lists<(Vec3, Vec3, f64)>,
+    /// The collider search's per-chunk results, kept for their buffers.
+    found: Vec<colliders::Found>,
     /// Surface pairs and feature pairs within reach.
     pub(in crate::integrator) pairs: Vec<Pair>,
     /// Per free body of the graph: whether a surface pair joins it to another body (then
