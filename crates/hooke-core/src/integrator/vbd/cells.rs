@@ -15,7 +15,7 @@ pub(in crate::integrator) type Aabb = (Vec3, Vec3);
 pub(in crate::integrator) type QueryBox<'a> = dyn Fn(usize) -> Aabb + Sync + 'a;
 
 /// Queries (or primitives) per parallel chunk.
-pub(in crate::integrator) const CHUNK: usize = 512;
+const CHUNK: usize = 512;
 
 /// `f` over fixed chunks of `0..n`, in parallel when there are several, each chunk's result
 /// in chunk order.
@@ -30,6 +30,24 @@ pub(in crate::integrator) fn per_chunk<R: Send>(
         .into_par_iter()
         .map(|c| f(c * CHUNK..((c + 1) * CHUNK).min(n)))
         .collect()
+}
+
+/// `f` over fixed chunks of `0..n` as [`per_chunk`], each chunk filling its own buffer of
+/// `buffers` (one per chunk, kept by the caller between calls, so that a call allocates
+/// nothing once they have grown).
+pub(in crate::integrator) fn each_chunk<R: Default + Send>(
+    n: usize,
+    buffers: &mut Vec<R>,
+    f: impl Fn(Range<usize>, &mut R) + Sync + Send,
+) {
+    buffers.resize_with(n.div_ceil(CHUNK).max(1), R::default);
+    if let [only] = &mut buffers[..] {
+        return f(0..n, only);
+    }
+    buffers
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(c, buffer)| f(c * CHUNK..((c + 1) * CHUNK).min(n), buffer));
 }
 
 /// `parts` end to end, in one allocation of exactly their length (a flattening collect

@@ -5,12 +5,11 @@
 use super::{CONTACT_STIFFNESS, Clearance, Detection, FELT};
 use crate::collider::response::Response;
 use crate::contact::proximity::feature_triangle;
-use crate::integrator::vbd::cells::{CHUNK, bounds_of, per_chunk};
+use crate::integrator::vbd::cells::{bounds_of, each_chunk, per_chunk};
 use crate::integrator::vbd::pairs::{Pair, Sides};
 use crate::integrator::vbd::planes::{HalfSpaces, Lists, Plane, Touches};
 use crate::model::Model;
 use crate::particles::Vec3;
-use rayon::prelude::*;
 
 /// The normal stiffness and Coulomb coefficient a collider's response gives a contact with
 /// stiffness scale `scale`.
@@ -75,25 +74,14 @@ impl Detection {
             found.touches.push(near.planes());
             found.halves.push(halves.planes());
         };
-        let n = x.len();
-        let fill = |c: usize, found: &mut Found| {
+        each_chunk(x.len(), &mut self.found, |range, found| {
             found.clearances.clear();
             found.touches.clear();
             found.halves.clear();
-            for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+            for i in range {
                 one(i, found);
             }
-        };
-        let chunks = &mut self.found;
-        chunks.resize_with(n.div_ceil(CHUNK).max(1), Found::default);
-        if chunks.len() == 1 {
-            fill(0, &mut chunks[0]);
-        } else {
-            chunks
-                .par_iter_mut()
-                .enumerate()
-                .for_each(|(c, found)| fill(c, found));
-        }
+        });
         self.point_collider.clear();
         self.touches.clear();
         self.halves.clear();
@@ -109,11 +97,11 @@ impl Detection {
     /// point moves in the step of length `dt`.
     pub(super) fn detect_features(&mut self, model: &Model, x: &[Vec3], reach: f64, dt: f64) {
         let triangles = &self.topology.triangles;
-        self.triangle_collider.clear();
-        self.triangle_collider
-            .resize(triangles.len(), Clearance::new(reach));
         self.pairs.clear();
         if !model.colliders.iter().any(|c| c.shape.has_features()) {
+            self.triangle_collider.clear();
+            self.triangle_collider
+                .resize(triangles.len(), Clearance::new(reach));
             return;
         }
         let scale = &self.scale;
