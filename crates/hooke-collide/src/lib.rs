@@ -37,6 +37,7 @@ mod obj;
 mod plane;
 mod polygons;
 mod sequence;
+mod sharp;
 mod shells;
 mod sphere;
 pub mod table;

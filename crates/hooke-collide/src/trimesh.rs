@@ -3,13 +3,13 @@
 
 use crate::bounds::{boxes_meet, touch_reach};
 use crate::obj::{MeshError, MeshPart};
+use crate::sharp::SharpEdges;
 use crate::shells::{closedness_defect, outward};
 use hooke_core::{Collider, Contact, Feature, Vec3};
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::query::{PointQuery, PointQueryWithLocation, Ray, RayCast};
 use parry3d_f64::shape::{TriMesh as ParryMesh, TriMeshFlags};
-use std::collections::HashMap;
 use std::path::Path;
 
 /// Crossings closer than this to the start of a step are the particle leaving a surface it
@@ -18,10 +18,6 @@ const CROSSING_EPSILON: f64 = 1e-9;
 /// A particle stopped at a crossing is left this far on the side it came from, so the next
 /// step's ray starts clear of the surface.
 const CROSSING_STANDOFF: f64 = 1e-7;
-/// Two faces meeting at an edge count as one flat surface when the far corner of one lies
-/// within this fraction of the edge's length of the other's plane (an angle under about
-/// 0.06°): the diagonals of a flat top are no edges a cloth can catch on.
-const FLAT_TOLERANCE: f64 = 1e-3;
 
 #[derive(Clone, Debug)]
 struct Part {
@@ -30,9 +26,8 @@ struct Part {
     closed: bool,
     /// Bounds of the part, for a cheap rejection before parry's BVH query.
     aabb: Aabb,
-    /// Per triangle, bit `k` set when its edge `k → k+1` is a sharp feature it owns (see
-    /// [`feature_edges`]).
-    features: Vec<u8>,
+    /// The edges a cloth can catch on, searched by their own boxes.
+    sharp: SharpEdges,
 }
 
 /// A collider made of the objects of one OBJ file.
@@ -48,11 +43,11 @@ pub struct TriMeshCollider {
     parts: Vec<Part>,
 }
 
-fn to_parry(v: &Vec3) -> PVec {
+pub(crate) fn to_parry(v: &Vec3) -> PVec {
     PVec::new(v.x, v.y, v.z)
 }
 
-fn from_parry(v: PVec) -> Vec3 {
+pub(crate) fn from_parry(v: PVec) -> Vec3 {
     Vec3::new(v.x, v.y, v.z)
 }
 
@@ -141,12 +136,12 @@ impl TriMeshCollider {
                 }
             })?;
             let aabb = mesh.local_aabb();
-            let features = feature_edges(&mesh, closed);
+            let sharp = SharpEdges::of(&mesh, closed);
             built.push(Part {
                 mesh,
                 closed,
                 aabb,
-                features,
+                sharp,
             });
         }
         Ok(Self {
@@ -201,57 +196,6 @@ impl TriMeshCollider {
             })
             .collect()
     }
-}
-
-/// Which edges of a mesh a cloth can catch on, as a bit mask per triangle: boundary edges,
-/// edges of three or more faces, and edges between two faces at an angle, where for a solid
-/// only convex edges count (a concave valley cannot poke through a sheet whose corners are
-/// outside). Each edge is owned by the lowest triangle that has it, so it is reported once.
-fn feature_edges(mesh: &ParryMesh, closed: bool) -> Vec<u8> {
-    let v = mesh.vertices();
-    let idx = mesh.indices();
-    let mut by_edge: HashMap<(u32, u32), Vec<(u32, u8)>> = HashMap::new();
-    for (t, tri) in idx.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            by_edge
-                .entry((a.min(b), a.max(b)))
-                .or_default()
-                .push((t as u32, k as u8));
-        }
-    }
-    let mut mask = vec![0u8; idx.len()];
-    for (&(a, b), faces) in &by_edge {
-        let sharp = match faces.as_slice() {
-            [(t1, _), (t2, _)] => {
-                let corner = |t: u32, skip: [u32; 2]| {
-                    idx[t as usize]
-                        .into_iter()
-                        .find(|i| !skip.contains(i))
-                        .map(|i| from_parry(v[i as usize]))
-                };
-                let tri = idx[*t1 as usize].map(|i| from_parry(v[i as usize]));
-                let normal = (tri[1] - tri[0]).cross(&(tri[2] - tri[0]));
-                let (pa, pb) = (from_parry(v[a as usize]), from_parry(v[b as usize]));
-                let length = (pb - pa).norm();
-                match (normal.try_normalize(0.0), corner(*t2, [a, b])) {
-                    (Some(n), Some(far)) => {
-                        let height = (far - pa).dot(&n);
-                        // For a solid with outward normals, the far corner below the first
-                        // face's plane makes the edge convex.
-                        height.abs() > FLAT_TOLERANCE * length && (!closed || height < 0.0)
-                    }
-                    _ => true,
-                }
-            }
-            _ => true,
-        };
-        if sharp {
-            let &(t, k) = faces.iter().min().expect("an edge has a face");
-            mask[t as usize] |= 1 << k;
-        }
-    }
-    mask
 }
 
 impl Part {
@@ -372,34 +316,15 @@ impl Collider for TriMeshCollider {
     }
 
     fn features(&self, lo: &Vec3, hi: &Vec3, sink: &mut dyn FnMut(Feature)) {
-        let query = Aabb::new(to_parry(lo), to_parry(hi));
         for part in &self.parts {
-            if !part.meets(lo, hi, 0.0) {
-                continue;
-            }
-            let v = part.mesh.vertices();
-            let idx = part.mesh.indices();
-            let mut found: Vec<u32> = part.mesh.bvh().intersect_aabb(&query).collect();
-            // The BVH's order is its own; features go out by triangle.
-            found.sort_unstable();
-            for t in found {
-                let mask = part.features[t as usize];
-                let tri = idx[t as usize];
-                for k in 0..3 {
-                    if mask & (1 << k) != 0 {
-                        let a = from_parry(v[tri[k] as usize]);
-                        let b = from_parry(v[tri[(k + 1) % 3] as usize]);
-                        sink(Feature::Segment([a, b]));
-                    }
-                }
+            if part.meets(lo, hi, 0.0) {
+                part.sharp.within(lo, hi, sink);
             }
         }
     }
 
     fn has_features(&self) -> bool {
-        self.parts
-            .iter()
-            .any(|p| p.features.iter().any(|&m| m != 0))
+        self.parts.iter().any(|p| !p.sharp.is_empty())
     }
 
     fn crossing(&self, from: &Vec3, to: &Vec3) -> Option<Contact> {

@@ -119,7 +119,12 @@ impl CrossingWatch {
                 .with_min_len(CHUNK)
                 .find_first(|tri| {
                     let [a, b, c] = tri.map(|i| &x[i as usize]);
-                    let (lo, hi) = (a.inf(b).inf(c), a.sup(b).sup(c));
+                    // Grown by what counts as through: a feature that near the triangle
+                    // may lie just outside its box.
+                    let (lo, hi) = (
+                        a.inf(b).inf(c).add_scalar(-THROUGH),
+                        a.sup(b).sup(c).add_scalar(THROUGH),
+                    );
                     let mut through = false;
                     shape.features(&lo, &hi, &mut |f| {
                         if !through {
