@@ -379,6 +379,16 @@ impl Exclusion {
         listed(&self.edge_start, &self.edges, e.max(f), e.min(f))
     }
 
+    /// The triangles skipped with particle `v` ([`Exclusion::skips_triangle`]), ascending.
+    pub(crate) fn triangles_of(&self, v: u32) -> &[u32] {
+        list(&self.triangle_start, &self.triangles, v as usize)
+    }
+
+    /// The edges below `e` skipped with it ([`Exclusion::skips_edges`]), ascending.
+    pub(crate) fn edges_below(&self, e: u32) -> &[u32] {
+        list(&self.edge_start, &self.edges, e as usize)
+    }
+
     /// How many pairs are listed.
     #[cfg(test)]
     fn len(&self) -> usize {
