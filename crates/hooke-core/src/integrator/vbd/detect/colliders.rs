@@ -5,7 +5,7 @@
 use super::{CONTACT_STIFFNESS, Clearance, Detection, FELT};
 use crate::collider::response::Response;
 use crate::contact::proximity::feature_triangle;
-use crate::integrator::vbd::cells::{bounds_of, each_chunk, per_chunk};
+use crate::integrator::vbd::cells::{bounds_of, each_chunk};
 use crate::integrator::vbd::pairs::{Pair, Sides};
 use crate::integrator::vbd::planes::{HalfSpaces, Lists, Plane, Touches};
 use crate::model::Model;
@@ -28,6 +28,14 @@ pub(super) struct Found {
     clearances: Vec<Clearance>,
     touches: Lists<Plane>,
     halves: Lists<(Vec3, Vec3, f64)>,
+}
+
+/// What a chunk of triangles' feature search found: each triangle's clearance, and the
+/// chunk's pairs in triangle order; kept between detections as [`Found`] is.
+#[derive(Clone, Debug, Default)]
+pub(super) struct FeaturesFound {
+    clearances: Vec<Clearance>,
+    pairs: Vec<Pair>,
 }
 
 impl Detection {
@@ -106,9 +114,10 @@ impl Detection {
         }
         let scale = &self.scale;
         let (points, touches) = (&self.point_collider, &self.touches);
-        // Per chunk: each triangle's clearance, and the chunk's pairs in triangle order.
-        let found = per_chunk(triangles.len(), |range| {
-            let (mut clearances, mut pairs) = (Vec::with_capacity(range.len()), Vec::new());
+        each_chunk(triangles.len(), &mut self.features_found, |range, found| {
+            let FeaturesFound { clearances, pairs } = found;
+            clearances.clear();
+            pairs.clear();
             for t in range {
                 let (tri, s) = triangles[t];
                 let [a, b, c] = tri.map(|i| &x[i as usize]);
@@ -165,12 +174,11 @@ impl Detection {
                 }
                 clearances.push(clearance);
             }
-            (clearances, pairs)
         });
         self.triangle_collider.clear();
-        for (clearances, pairs) in found {
-            self.triangle_collider.extend_from_slice(&clearances);
-            self.pairs.extend_from_slice(&pairs);
+        for found in &self.features_found {
+            self.triangle_collider.extend_from_slice(&found.clearances);
+            self.pairs.extend_from_slice(&found.pairs);
         }
     }
 }

@@ -119,6 +119,8 @@ pub(in crate::integrator) struct Detection {
     pub(in crate::integrator) halves: Lists<(Vec3, Vec3, f64)>,
     /// The collider search's per-chunk results, kept for their buffers.
     found: Vec<colliders::Found>,
+    /// The feature search's per-chunk results, kept for their buffers.
+    features_found: Vec<colliders::FeaturesFound>,
     /// Surface pairs and feature pairs within reach.
     pub(in crate::integrator) pairs: Vec<Pair>,
     /// Per free body of the graph: whether a surface pair joins it to another body (then
