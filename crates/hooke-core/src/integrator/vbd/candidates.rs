@@ -24,7 +24,6 @@ use crate::contact::grid::{Cell, Grid};
 use crate::contact::proximity::{point_triangle_distance, segment_distance};
 use crate::particles::Vec3;
 use rayon::prelude::*;
-use std::cell::RefCell;
 
 /// The skin of a build, as a share of the reach it serves.
 pub(in crate::integrator) const SKIN: f64 = 1.0;
@@ -263,30 +262,6 @@ fn check(
     concatenate(list.par_iter_mut().map(run).collect())
 }
 
-thread_local! {
-    /// A flag per primitive, set only while a query runs (see [`marking`]).
-    static MARKED: RefCell<Vec<bool>> = const { RefCell::new(Vec::new()) };
-}
-
-/// `f` with a flag per primitive (of `n`) that is set for those in `listed` alone: a
-/// query's skipped pairs looked up by index instead of searched for each candidate (the
-/// search was a third of the build's own time). The flags are the thread's, kept between
-/// queries and cleared after each; one a panic leaves behind is dropped, not reused.
-fn marking(n: usize, listed: &[u32], f: impl FnOnce(&[bool])) {
-    let mut marked = MARKED.take();
-    if marked.len() < n {
-        marked.resize(n, false);
-    }
-    for &k in listed {
-        marked[k as usize] = true;
-    }
-    f(&marked);
-    for &k in listed {
-        marked[k as usize] = false;
-    }
-    MARKED.set(marked);
-}
-
 /// Every point–triangle pair (a surface particle, a triangle not holding it) and edge–edge
 /// pair (sharing no particle; each unordered pair once) of the surfaces within `reach` at
 /// `x` that `skip` does not hold apart, measured, through the grids' search. Each search's
@@ -321,30 +296,26 @@ fn point_triangle_pairs(
         grid,
         &at,
         (&point, &tri_boxes, reach),
-        |v, candidates, out: &mut Part| {
+        |v, candidates, skipped, out: &mut Part| {
             if topo.surface[v] == u16::MAX {
                 return;
             }
             let p = &x[v];
-            marking(
-                topo.triangles.len(),
-                skip.triangles_of(v as u32),
-                |skipped| {
-                    for &t in candidates {
-                        let (tri, _) = topo.triangles[t as usize];
-                        if tri.contains(&(v as u32))
-                            || !within(p, &tri_boxes[t as usize], reach)
-                            || skipped[t as usize]
-                        {
-                            continue;
-                        }
-                        let d = point_triangle_distance(p, tri.map(|i| &x[i as usize]));
-                        if d < reach {
-                            out.push(v as u32, t, d);
-                        }
+            skipped.hold(skip.triangles_of(v as u32), |skipped| {
+                for &t in candidates {
+                    let (tri, _) = topo.triangles[t as usize];
+                    if tri.contains(&(v as u32))
+                        || !within(p, &tri_boxes[t as usize], reach)
+                        || skipped[t as usize]
+                    {
+                        continue;
                     }
-                },
-            );
+                    let d = point_triangle_distance(p, tri.map(|i| &x[i as usize]));
+                    if d < reach {
+                        out.push(v as u32, t, d);
+                    }
+                }
+            });
         },
         Part::shrink,
     )
@@ -371,10 +342,10 @@ fn edge_pairs((topo, skip): (&Topology, &Exclusion), x: &[Vec3], reach: f64) -> 
         grid,
         &at,
         (&edge, &edge_boxes, reach),
-        |e, candidates, out: &mut Part| {
+        |e, candidates, skipped, out: &mut Part| {
             let ([a, b], _) = topo.edges[e];
             let bx = &edge_boxes[e];
-            marking(topo.edges.len(), skip.edges_below(e as u32), |skipped| {
+            skipped.hold(skip.edges_below(e as u32), |skipped| {
                 for &f in candidates {
                     let f = f as usize;
                     if f >= e {

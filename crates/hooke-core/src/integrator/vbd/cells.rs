@@ -6,6 +6,7 @@
 use crate::contact::grid::{Cell, Grid};
 use crate::particles::Vec3;
 use rayon::prelude::*;
+use std::cell::RefCell;
 use std::ops::Range;
 
 /// A box as its low and high corners.
@@ -91,12 +92,37 @@ pub(in crate::integrator) fn bin(grid: &mut Grid, boxes: &[(Vec3, Vec3)], reach:
     grid.build(extent + reach, boxes.iter().map(|(lo, _)| *lo));
 }
 
-/// Calls `test(q, candidates, out)` for every query `q` whose cell is `cells[q]`, with the
+thread_local! {
+    /// The flags a chunk of queries works with ([`Flags`]), kept per thread.
+    static FLAGS: RefCell<Vec<bool>> = const { RefCell::new(Vec::new()) };
+}
+
+/// A flag per item, all clear between queries: a query sets those of its own list (the
+/// items its pairs skip), reads them by index instead of searching the list for each
+/// candidate (the search was a third of the pair list's build), and clears them.
+pub(in crate::integrator) struct Flags(Vec<bool>);
+
+impl Flags {
+    /// `f` with the flags of `listed` set, and only those.
+    pub(in crate::integrator) fn hold(&mut self, listed: &[u32], f: impl FnOnce(&[bool])) {
+        for &k in listed {
+            self.0[k as usize] = true;
+        }
+        f(&self.0);
+        for &k in listed {
+            self.0[k as usize] = false;
+        }
+    }
+}
+
+/// Calls `test(q, candidates, flags, out)` for every query `q` whose cell is `cells[q]`, with the
 /// items of the 27 cells around that cell (every item whose low corner lies within one cell
 /// of the query's), gathered once per occupied cell. Results come in the order of (cell,
 /// query), in parts of consecutive cells, each part `finish`ed as soon as it is whole (so
 /// that its slack goes before the next is grown): fixed by the positions alone, never by
 /// threads.
+///
+/// `flags` has a flag per item, all clear ([`Flags`]), taken once per chunk.
 ///
 /// `boxes` (each query's box, each item's box, the reach) prunes a cell's items to those
 /// whose box comes within the reach of its queries' joint box (by a nanometre more, so
@@ -106,7 +132,7 @@ pub(in crate::integrator) fn by_cell<P: Default + Send>(
     grid: &Grid,
     cells: &[Cell],
     boxes: (&QueryBox<'_>, &[Aabb], f64),
-    test: impl Fn(usize, &[u32], &mut P) + Sync + Send,
+    test: impl Fn(usize, &[u32], &mut Flags, &mut P) + Sync + Send,
     finish: impl Fn(&mut P) + Sync + Send,
 ) -> Vec<P> {
     let (query_box, item_boxes, reach) = boxes;
@@ -120,6 +146,11 @@ pub(in crate::integrator) fn by_cell<P: Default + Send>(
     per_chunk(starts.len() - 1, |groups| {
         let mut out = P::default();
         let mut candidates = Vec::new();
+        // The thread's flags, taken for the chunk: a panic drops them, never leaving any set.
+        let mut flags = Flags(FLAGS.take());
+        if flags.0.len() < item_boxes.len() {
+            flags.0.resize(item_boxes.len(), false);
+        }
         for g in groups {
             let members = &order[starts[g]..starts[g + 1]];
             let c = cells[members[0] as usize];
@@ -141,9 +172,10 @@ pub(in crate::integrator) fn by_cell<P: Default + Send>(
                 }
             }
             for &q in members {
-                test(q as usize, &candidates, &mut out);
+                test(q as usize, &candidates, &mut flags, &mut out);
             }
         }
+        FLAGS.set(flags.0);
         finish(&mut out);
         out
     })

@@ -115,7 +115,13 @@ impl Detection {
         let scale = &self.scale;
         let (points, touches) = (&self.point_collider, &self.touches);
         each_chunk(triangles.len(), &mut self.features_found, |range, found| {
-            let FeaturesFound { clearances, pairs } = found;
+            // Worked on as the closure's own, not through `found`: the features' sink is a
+            // call the compiler cannot see into, and behind a reference each push reloaded
+            // the vectors around it.
+            let (mut clearances, mut pairs) = (
+                std::mem::take(&mut found.clearances),
+                std::mem::take(&mut found.pairs),
+            );
             clearances.clear();
             pairs.clear();
             for t in range {
@@ -174,6 +180,7 @@ impl Detection {
                 }
                 clearances.push(clearance);
             }
+            *found = FeaturesFound { clearances, pairs };
         });
         self.triangle_collider.clear();
         for found in &self.features_found {
