@@ -31,6 +31,7 @@
 mod bounds;
 mod box_interior;
 mod cache;
+mod convert;
 mod cylinder;
 mod deforming;
 mod obj;

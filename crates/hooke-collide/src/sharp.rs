@@ -5,7 +5,7 @@
 //! point of the top: a cloth triangle asking for the rim's edges near it would visit them
 //! all and be handed edges a metre away.
 
-use crate::trimesh::{from_parry, to_parry};
+use crate::convert::{from_parry, to_parry};
 use hooke_core::{Feature, Vec3};
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};

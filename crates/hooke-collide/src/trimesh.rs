@@ -2,12 +2,12 @@
 //! answers the crossing test so that a thin tabletop cannot be tunnelled through.
 
 use crate::bounds::{boxes_meet, touch_reach};
+use crate::convert::{from_parry, to_parry};
 use crate::obj::{MeshError, MeshPart};
 use crate::sharp::SharpEdges;
 use crate::shells::{closedness_defect, outward};
 use hooke_core::{Collider, Contact, Feature, Vec3};
 use parry3d_f64::bounding_volume::Aabb;
-use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::query::{PointQuery, PointQueryWithLocation, Ray, RayCast};
 use parry3d_f64::shape::{TriMesh as ParryMesh, TriMeshFlags};
 use std::path::Path;
@@ -41,14 +41,6 @@ struct Part {
 pub struct TriMeshCollider {
     label: String,
     parts: Vec<Part>,
-}
-
-pub(crate) fn to_parry(v: &Vec3) -> PVec {
-    PVec::new(v.x, v.y, v.z)
-}
-
-pub(crate) fn from_parry(v: PVec) -> Vec3 {
-    Vec3::new(v.x, v.y, v.z)
 }
 
 impl TriMeshCollider {
