@@ -115,12 +115,12 @@ impl Flags {
     }
 }
 
-/// Calls `test(q, candidates, flags, out)` for every query `q` whose cell is `cells[q]`, with the
-/// items of the 27 cells around that cell (every item whose low corner lies within one cell
-/// of the query's), gathered once per occupied cell. Results come in the order of (cell,
-/// query), in parts of consecutive cells, each part `finish`ed as soon as it is whole (so
-/// that its slack goes before the next is grown): fixed by the positions alone, never by
-/// threads.
+/// Calls `test(q, candidates, flags, out)` for every query `q` whose cell is `cells[q]`,
+/// with the items of the 27 cells around that cell (every item whose low corner lies within
+/// one cell of the query's), gathered once per occupied cell. Results come in the order of
+/// (cell, query), in parts of consecutive cells, each part `finish`ed as soon as it is whole
+/// (so that its slack goes before the next is grown): fixed by the positions alone, never
+/// by threads.
 ///
 /// `flags` has a flag per item, all clear ([`Flags`]), taken once per chunk.
 ///
