@@ -22,6 +22,7 @@ mod large_steps;
 mod layers;
 mod layout;
 mod material;
+mod mesh_files;
 mod meshes;
 mod motion;
 mod newton;
