@@ -80,6 +80,10 @@ struct TimeSplit {
     /// One detection's wall time, milliseconds: the detection's time (recolouring, the
     /// step's targets and first guess included) over the detections.
     detection_ms: f64,
+    /// The self-contact pair list's builds (part of `detection`), seconds, and how many
+    /// there were per step.
+    pair_list_building: f64,
+    pair_list_builds_per_step: f64,
 }
 
 pub(super) fn scene_steps(
@@ -142,6 +146,11 @@ pub(super) fn scene_steps(
             rest: seconds - detection - sweeps - coarse_correction - acceleration,
             sweep_ns_per_particle: 1e9 * per(sweeps, vbd_iterations as f64 * free as f64),
             detection_ms: 1e3 * per(detection, vbd_detections as f64),
+            pair_list_building: part(now.pair_list_building, times_before.pair_list_building),
+            pair_list_builds_per_step: per(
+                (now.pair_list_builds - times_before.pair_list_builds) as f64,
+                steps as f64,
+            ),
         }
     });
     final_speeds.sort_by(f64::total_cmp);
@@ -233,10 +242,13 @@ pub(super) fn scene_steps(
                         .time_split
                         .as_ref()
                         .map_or(String::new(), |t| format!(
-                            "; time: detection {:.0}% ({:.2} ms each), sweeps {:.0}% ({:.0} ns a \
-                         particle), coarse correction {:.0}%, acceleration {:.0}%, rest {:.0}%",
+                            "; time: detection {:.0}% ({:.2} ms each; pair-list builds {:.0}%, \
+                             {:.2} a step), sweeps {:.0}% ({:.0} ns a particle), coarse \
+                             correction {:.0}%, acceleration {:.0}%, rest {:.0}%",
                             100.0 * t.detection / seconds,
                             t.detection_ms,
+                            100.0 * t.pair_list_building / seconds,
+                            t.pair_list_builds_per_step,
                             100.0 * t.sweeps / seconds,
                             t.sweep_ns_per_particle,
                             100.0 * t.coarse_correction / seconds,

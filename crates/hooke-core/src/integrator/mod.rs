@@ -69,6 +69,10 @@ pub struct SolveTimes {
     pub coarse: std::time::Duration,
     /// The acceleration (and the copies that keep its iterates).
     pub acceleration: std::time::Duration,
+    /// Builds of the self-contact pair list.
+    pub pair_list_builds: u64,
+    /// Their time (part of `detection`).
+    pub pair_list_building: std::time::Duration,
 }
 
 /// A stopwatch read in laps: each [`Lap::lap`] is the time since the last.
@@ -362,7 +366,12 @@ impl Workspace {
 
     /// Where block descent's time went, summed over the steps so far.
     pub fn solve_times(&self) -> SolveTimes {
-        self.vbd.times
+        let (pair_list_builds, pair_list_building) = self.vbd.detection.builds();
+        SolveTimes {
+            pair_list_builds,
+            pair_list_building,
+            ..self.vbd.times
+        }
     }
 
     /// The rule block descent (or Newton, `newton`) ends its steps by.

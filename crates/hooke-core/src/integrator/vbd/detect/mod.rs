@@ -148,6 +148,8 @@ pub(in crate::integrator) struct Detection {
     scratch_allowed: Vec<f64>,
     /// Surface pairs kept between detections (see [`Candidates`]).
     candidates: Candidates,
+    /// The pair list's builds so far, and their time.
+    builds: (u64, std::time::Duration),
     /// The largest thickness of the active surfaces.
     h_max: f64,
     /// Per particle: how far a pinned surface particle moves over the step apart from the
@@ -174,6 +176,11 @@ impl Detection {
     /// The pairs the surfaces' own structure holds apart (empty before the first detection).
     pub(in crate::integrator) fn exclusion(&self) -> &Exclusion {
         &self.exclusion
+    }
+
+    /// The pair list's builds so far, and the time they took.
+    pub(in crate::integrator) fn builds(&self) -> (u64, std::time::Duration) {
+        self.builds
     }
 
     /// Particle `i`'s pairs.
@@ -352,10 +359,13 @@ impl Detection {
         if self.candidates.stale(reach) {
             // The old list goes before the new one is searched: the two at once were the
             // block-descent step's peak memory.
+            let started = std::time::Instant::now();
             self.candidates.forget();
             let built = reach + SKIN * reach;
             let (point_tri, edge_edge) = search((topo, &self.exclusion), x, built);
             self.candidates.rebuild(built, point_tri, edge_edge);
+            self.builds.0 += 1;
+            self.builds.1 += started.elapsed();
         }
         let (found, found_edges) = self.candidates.within(topo, x, reach);
         for (v, t, d) in found {
