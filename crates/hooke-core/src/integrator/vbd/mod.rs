@@ -51,6 +51,11 @@ const DETECT_SHARE: f64 = 0.01;
 const CHEBYSHEV: f64 = 0.9;
 /// Particles per parallel chunk of a colour (a whole number of the lanes' blocks).
 const CHUNK: usize = 256;
+/// Up to this many chunks (a 32² cloth), the coarse step sums a body's chunks in order on
+/// the calling thread: waking the pool at every iteration cost more than it saved (on
+/// cloth-table the coarse step took 0.27 s of 3 s in parallel, 0.18 s so; a 36² cloth, six
+/// chunks, takes the same either way). The chunks and their order, so the bits, are the same.
+const SERIAL_CHUNKS: usize = 4;
 const _: () = assert!(CHUNK.is_multiple_of(LANES));
 
 /// Buffers of the block-descent step, kept between steps.
@@ -395,8 +400,10 @@ fn translate_bodies(
                 out.1 = out.1.plus(&h);
             }
         };
-        if chunks == 1 {
-            sum(body, &mut parts[0]);
+        if chunks <= SERIAL_CHUNKS {
+            for (ids, out) in body.chunks(CHUNK).zip(parts.iter_mut()) {
+                sum(ids, out);
+            }
         } else {
             body.par_chunks(CHUNK)
                 .zip(parts.par_iter_mut())
