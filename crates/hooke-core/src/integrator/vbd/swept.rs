@@ -66,8 +66,8 @@ mod tests {
     use super::*;
     use crate::collider::response::Response;
     use crate::collider::{Collider, Contact, Feature};
-    use crate::model::surface::Surface;
-    use crate::model::{ColliderSlot, Model};
+    use crate::contact::exclusion::tests::sheet;
+    use crate::model::ColliderSlot;
     use crate::particles::Vec3;
 
     /// A ball of radius 0.3 at the origin, with straight spikes standing out of it: the
@@ -169,40 +169,27 @@ mod tests {
         let n = 48;
         let mut found = 0;
         for (height, spacing) in [(0.36, 0.02), (0.42, 0.015), (0.6, 0.03), (2.0, 0.02)] {
-            let mut p = Particles::default();
-            for j in 0..n {
-                for i in 0..n {
-                    let x = Vec3::new(
+            let (mut model, x) = sheet(
+                n,
+                0.002,
+                |_, _| false,
+                |i, j| {
+                    Vec3::new(
                         (i as f64 - n as f64 / 2.0) * spacing + 0.3 * spacing * jitter(&mut state),
                         height + 0.05 * jitter(&mut state),
                         (j as f64 - n as f64 / 2.0) * spacing + 0.3 * spacing * jitter(&mut state),
-                    );
-                    p.push(x, Vec3::zeros(), 1e-3);
-                }
+                    )
+                },
+            );
+            model.colliders.push(ColliderSlot {
+                shape: Box::new(Spiky(spikes.clone())),
+                response: Response::Stick,
+            });
+            let mut p = Particles::default();
+            for x in x {
+                p.push(x, Vec3::zeros(), 1e-3);
             }
             p.pin(0);
-            let mut triangles = Vec::new();
-            for j in 0..n - 1 {
-                for i in 0..n - 1 {
-                    let a = (j * n + i) as u32;
-                    let (b, c, d) = (a + 1, a + n as u32, a + n as u32 + 1);
-                    triangles.extend([[a, b, d], [a, d, c]]);
-                }
-            }
-            let model = Model {
-                surfaces: vec![Surface {
-                    particles: 0..n * n,
-                    triangles,
-                    thickness: 0.002,
-                    self_collision: true,
-                    friction: 0.0,
-                }],
-                colliders: vec![ColliderSlot {
-                    shape: Box::new(Spiky(spikes.clone())),
-                    response: Response::Stick,
-                }],
-                ..Model::default()
-            };
             for reach in [0.01, 0.1, 0.5] {
                 let want = every_pair(&model, &p, 0, reach);
                 assert_eq!(
