@@ -51,12 +51,12 @@ const DETECT_SHARE: f64 = 0.01;
 const CHEBYSHEV: f64 = 0.9;
 /// Particles per parallel chunk of a colour (a whole number of the lanes' blocks).
 const CHUNK: usize = 256;
+const _: () = assert!(CHUNK.is_multiple_of(LANES));
 /// Up to this many chunks (a 32² cloth), the coarse step sums a body's chunks in order on
 /// the calling thread: waking the pool at every iteration cost more than it saved (on
 /// cloth-table the coarse step took 0.27 s of 3 s in parallel, 0.18 s so; a 36² cloth, six
 /// chunks, takes the same either way). The chunks and their order, so the bits, are the same.
 const SERIAL_CHUNKS: usize = 4;
-const _: () = assert!(CHUNK.is_multiple_of(LANES));
 
 /// Buffers of the block-descent step, kept between steps.
 #[derive(Clone, Debug, Default)]
