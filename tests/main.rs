@@ -14,6 +14,7 @@ mod contact;
 mod creases;
 mod deforming;
 mod determinism;
+mod documents;
 mod drape;
 mod face_order;
 mod friction;
