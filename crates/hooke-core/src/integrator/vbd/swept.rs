@@ -12,8 +12,9 @@ use crate::particles::Particles;
 ///
 /// A least distance is the same whatever order its candidates come in, so the search runs
 /// over fixed chunks in parallel, and each search reaches only as far as the least gap its
-/// chunk has found yet (by a margin that covers the rounding of a contact's depth): a
-/// primitive farther away cannot lower it. The swept step asks this before every part, with
+/// chunk has found yet (by a margin that covers the rounding of a distance), never farther
+/// than the reach: a primitive farther away cannot lower it, and none the whole reach's
+/// search would miss is met. The swept step asks this before every part, with
 /// a reach of twice the collider's sweep (a table turning at 1 rev/s: 10 cm), where asking
 /// every triangle for every feature within the reach was half of the step's time.
 pub(crate) fn collider_gap(model: &Model, p: &Particles, k: usize, reach: f64) -> f64 {
@@ -24,7 +25,7 @@ pub(crate) fn collider_gap(model: &Model, p: &Particles, k: usize, reach: f64) -
         let mut gap = reach;
         for i in range {
             let x = &p.x[i];
-            let near = gap + margin;
+            let near = (gap + margin).min(reach);
             if p.is_pinned(i) || !shape.may_touch(&x.add_scalar(-near), &x.add_scalar(near), 0.0) {
                 continue;
             }
@@ -50,7 +51,7 @@ pub(crate) fn collider_gap(model: &Model, p: &Particles, k: usize, reach: f64) -
         for tri in &triangles[range] {
             let [a, b, c] = tri.map(|i| &p.x[i as usize]);
             let (lo, hi) = bounds_of(&[a, b, c]);
-            let near = gap + margin;
+            let near = (gap + margin).min(reach);
             shape.features(&lo.add_scalar(-near), &hi.add_scalar(near), &mut |f| {
                 let (anchor, w) = feature_triangle(&f, a, b, c);
                 gap = gap.min((a * w[0] + b * w[1] + c * w[2] - anchor).norm());
