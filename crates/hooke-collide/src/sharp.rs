@@ -158,22 +158,12 @@ mod tests {
     }
 
     /// Boxes of every size over the table hand out exactly the sharp edges that meet them,
-    /// in the owning triangles' order: what a search of every triangle's edges gives.
+    /// in the edges' own order (their owning triangles'): what testing every edge gives.
     #[test]
     fn a_query_finds_exactly_the_edges_that_meet_its_box_in_triangle_order() {
         let mesh = table();
         let sharp = SharpEdges::of(&mesh, false);
-        let masks = feature_edges(&mesh, false);
-        let v = mesh.vertices();
-        let mut all = Vec::new();
-        for (t, tri) in mesh.indices().iter().enumerate() {
-            for k in 0..3 {
-                if masks[t] & (1 << k) != 0 {
-                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                    all.push([from_parry(v[a as usize]), from_parry(v[b as usize])]);
-                }
-            }
-        }
+        let all = &sharp.segments;
         // The rim's circle and the pedestal: edges to find, and far more of them than any
         // small box meets.
         assert!(all.len() > 100, "{} sharp edges", all.len());

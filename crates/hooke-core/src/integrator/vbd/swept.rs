@@ -41,25 +41,24 @@ pub(crate) fn collider_gap(model: &Model, p: &Particles, k: usize, reach: f64) -
     if !shape.has_features() {
         return particles;
     }
-    let triangles: Vec<[u32; 3]> = model
-        .surfaces
-        .iter()
-        .flat_map(|s| s.triangles.iter().copied())
-        .collect();
-    let features = least(per_chunk(triangles.len(), |range| {
-        let mut gap = particles;
-        for tri in &triangles[range] {
-            let [a, b, c] = tri.map(|i| &p.x[i as usize]);
-            let (lo, hi) = bounds_of(&[a, b, c]);
-            let near = (gap + margin).min(reach);
-            shape.features(&lo.add_scalar(-near), &hi.add_scalar(near), &mut |f| {
-                let (anchor, w) = feature_triangle(&f, a, b, c);
-                gap = gap.min((a * w[0] + b * w[1] + c * w[2] - anchor).norm());
-            });
-        }
-        gap
-    }));
-    particles.min(features)
+    let mut gap = particles;
+    for surface in &model.surfaces {
+        let triangles = &surface.triangles;
+        gap = gap.min(least(per_chunk(triangles.len(), |range| {
+            let mut gap = gap;
+            for tri in &triangles[range] {
+                let [a, b, c] = tri.map(|i| &p.x[i as usize]);
+                let (lo, hi) = bounds_of(&[a, b, c]);
+                let near = (gap + margin).min(reach);
+                shape.features(&lo.add_scalar(-near), &hi.add_scalar(near), &mut |f| {
+                    let (anchor, w) = feature_triangle(&f, a, b, c);
+                    gap = gap.min((a * w[0] + b * w[1] + c * w[2] - anchor).norm());
+                });
+            }
+            gap
+        })));
+    }
+    gap
 }
 
 #[cfg(test)]
