@@ -147,3 +147,36 @@ impl Watched {
         (status, said)
     }
 }
+
+/// How many files in `dir` end in `.ext` (none when it does not exist).
+pub fn count_files(dir: &Path, ext: &str) -> usize {
+    std::fs::read_dir(dir).map_or(0, |d| {
+        d.flatten()
+            .filter(|e| e.path().extension().is_some_and(|x| x == ext))
+            .count()
+    })
+}
+
+/// How many of `taken` frames, `seconds` of simulated time apart, a GIF shows: all when
+/// they are two hundredths of a second apart or more, else the one nearest each slot of two
+/// hundredths (the GIF plays in real time; `hooke::image_out::GifWriter`).
+pub fn shown(taken: usize, seconds: f64) -> usize {
+    let period = seconds * 100.0;
+    if period >= 2.0 {
+        return taken;
+    }
+    (0..)
+        .take_while(|j| ((*j as f64) * 2.0 / period).round() < taken as f64)
+        .count()
+}
+
+pub fn gif_frames(path: &Path) -> usize {
+    use image::AnimationDecoder;
+    let file = std::io::BufReader::new(std::fs::File::open(path).unwrap());
+    image::codecs::gif::GifDecoder::new(file)
+        .unwrap()
+        .into_frames()
+        .collect_frames()
+        .unwrap()
+        .len()
+}
