@@ -28,6 +28,9 @@ class Simulation:
     @property
     def steps_taken(self) -> int: ...
     @property
+    def unsolved_steps(self) -> int:
+        """Steps the large-step integrator ended at its iteration budget before its tolerance."""
+    @property
     def total_steps(self) -> int: ...
     @property
     def every(self) -> int: ...

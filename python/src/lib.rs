@@ -222,6 +222,14 @@ impl Simulation {
         Ok(self.lock()?.scene.simulation.steps())
     }
 
+    /// Steps so far that the large-step integrator ended at its iteration budget before its
+    /// stopping rule was met (docs/physics.md §4.1, "Stopping rule and accuracy"): zero for
+    /// the explicit integrators.
+    #[getter]
+    fn unsolved_steps(&self) -> PyResult<u64> {
+        Ok(self.lock()?.scene.simulation.unsolved().steps)
+    }
+
     /// The step size in seconds.
     #[getter]
     fn dt(&self) -> PyResult<f64> {

@@ -98,6 +98,19 @@ def test_advance_takes_the_nearest_whole_number_of_steps():
         sim.advance(1e300)
 
 
+def test_steps_ended_at_the_large_steps_budget_are_counted():
+    starved = hooke.load("hanging-cloth", integrator="vbd", dt=1 / 60, iterations=1)
+    starved.step(6)
+    assert starved.unsolved_steps == 6
+    fed = hooke.load("hanging-cloth", integrator="vbd", dt=1 / 60, iterations=5000,
+                     tolerance=0.5)
+    fed.step(6)
+    assert fed.unsolved_steps == 0
+    explicit = hooke.load("hanging-cloth")
+    explicit.step(6)
+    assert explicit.unsolved_steps == 0
+
+
 def test_bad_input_raises_with_the_file_line_or_key(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text('name = "x"\n[simulation]\nintegrator = "rk5"\ndt = 0.001\nsteps = 10\nevery = 1\n')

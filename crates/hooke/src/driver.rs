@@ -55,6 +55,53 @@ fn tally_notices(scene: &Scene) {
     }
 }
 
+/// Says, at a run's end, how many of its steps the large-step integrator ended at its
+/// iteration budget before its stopping rule was met, and the first of them: a result that
+/// may be short of what was asked says so (docs/physics.md §4.1, "Stopping rule and
+/// accuracy").
+fn tally_unsolved(scene: &Scene) {
+    let sim = &scene.simulation;
+    let unsolved = sim.unsolved();
+    if let Some(said) = unsolved_note(sim.integrator(), unsolved, sim.steps(), sim.workspace()) {
+        reporter().note(&said);
+    }
+}
+
+/// The sentence [`tally_unsolved`] says, when there is anything to say.
+fn unsolved_note(
+    integrator: hooke_core::Integrator,
+    unsolved: hooke_core::Unsolved,
+    steps: u64,
+    workspace: &hooke_core::integrator::Workspace,
+) -> Option<String> {
+    let (first, time) = unsolved.first?;
+    let n = unsolved.steps;
+    let what = if integrator == hooke_core::Integrator::Implicit {
+        "with its conjugate gradients at their iteration cap, above their tolerance".to_string()
+    } else {
+        let rule = workspace.stop_rule_of(integrator);
+        format!(
+            "at its budget of {} iteration{} before its tolerance of {} m/s",
+            rule.iterations,
+            if rule.iterations == 1 { "" } else { "s" },
+            hooke_core::Approx(rule.tolerance)
+        )
+    };
+    let fix = if integrator.solves_contacts() {
+        "; `--iterations` raises the budget, and `hooke bench scene --residual` measures what \
+         is left"
+    } else {
+        ""
+    };
+    Some(format!(
+        "{integrator} ended {n} of {steps} step{} {what}, the first at step {first} \
+         (t = {} s): those steps stopped short of their solution (docs/physics.md §4.1, \
+         \"Stopping rule and accuracy\"){fix}",
+        if steps == 1 { "" } else { "s" },
+        hooke_core::Approx(time),
+    ))
+}
+
 /// What a notice's surface passed through, as said.
 fn through(scene: &Scene, through: hooke_core::Through) -> String {
     match through {
@@ -191,6 +238,7 @@ pub fn drive(scene: &mut Scene, mut on_frame: impl FnMut(u64, &Scene) -> Result<
     steps(scene, total % every, bar.as_ref())?;
     bar.finish();
     tally_notices(scene);
+    tally_unsolved(scene);
     Ok(())
 }
 
@@ -200,6 +248,7 @@ pub fn advance(scene: &mut Scene, n: u64) -> Result<()> {
     steps(scene, n, bar.as_ref())?;
     bar.finish();
     tally_notices(scene);
+    tally_unsolved(scene);
     Ok(())
 }
 

@@ -23,6 +23,12 @@ pub trait Reporter: Send + Sync {
     fn warn(&self, message: &str) {
         eprintln!("warning: {message}");
     }
+    /// A run's result may be short of what was asked, though no promise was broken (steps
+    /// that ended at their solver's budget); `message` says how. The default prints
+    /// `note: MESSAGE` on stderr.
+    fn note(&self, message: &str) {
+        eprintln!("note: {message}");
+    }
 }
 
 /// One job's progress.

@@ -13,6 +13,7 @@ pub(crate) mod stability;
 pub(crate) mod start;
 pub(crate) mod summary;
 pub(crate) mod swept;
+pub(crate) mod unsolved;
 mod watch;
 
 use crate::assembly::kernel::Kernel;
@@ -28,6 +29,7 @@ use notice::{Cause, Notice, Notices, Through};
 use renumber::Renumbering;
 use runaway::EnergyWatch;
 use stability::StabilityEstimate;
+use unsolved::Unsolved;
 use watch::CrossingWatch;
 
 /// A mass-spring system being simulated.
@@ -68,6 +70,8 @@ pub struct Simulation {
     crossings: CrossingWatch,
     layers: LayerWatch,
     notices: Notices,
+    /// The steps ended at the solver's budget.
+    unsolved: Unsolved,
 }
 
 /// Why [`Simulation::renumber`] refused a renumbering.
@@ -124,6 +128,7 @@ impl Simulation {
             crossings: CrossingWatch::default(),
             layers: LayerWatch::default(),
             notices: Notices::default(),
+            unsolved: Unsolved::default(),
         }
     }
 
@@ -345,6 +350,9 @@ impl Simulation {
         };
         self.step += 1;
         self.end_pins(time + self.dt);
+        if self.workspace.capped() {
+            self.unsolved.record(self.step, self.time());
+        }
         let (moved, crowded) = match phase {
             Ok(moved) => (moved, None),
             Err(crowded) => (true, Some(crowded)),
@@ -550,6 +558,12 @@ impl Simulation {
                 p.x[i] = at;
             }
         }
+    }
+
+    /// The steps so far that the integrator ended at its iteration budget before its
+    /// stopping rule was met (none for the explicit integrators).
+    pub fn unsolved(&self) -> Unsolved {
+        self.unsolved
     }
 
     /// Advances `steps` steps, stopping at the first divergence.
