@@ -561,32 +561,3 @@ fn pictures_take_a_colour_map_a_range_and_a_placed_camera() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
-
-/// A large-step run whose steps end at the solver's budget says how many and which came
-/// first, at its end: every one of a hanging cloth's steps with a budget of one sweep, none
-/// with a budget its steps never reach, and never for an explicit integrator, which has no
-/// budget.
-#[test]
-fn a_run_says_how_many_steps_ended_at_the_solvers_budget() {
-    let dir = scratch("unsolved");
-    let run = |extra: &[&str]| {
-        let mut args = vec!["run", "hanging-cloth", "--steps", "12"];
-        args.extend_from_slice(extra);
-        let out = hooke(&args, &dir);
-        assert!(out.status.success(), "{extra:?}: {}", stderr(&out));
-        stderr(&out)
-    };
-    let vbd = ["--integrator", "vbd", "--dt", "0.016666666666666666"];
-    let starved = run(&[&vbd[..], &["--iterations", "1"]].concat());
-    assert!(
-        starved.contains("note: vbd ended 12 of 12 steps at its budget of 1 iteration ")
-            && starved.contains("the first at step 1 ")
-            && starved.contains("--iterations"),
-        "{starved}"
-    );
-    let fed = run(&[&vbd[..], &["--iterations", "5000", "--tolerance", "0.5"]].concat());
-    assert!(!fed.contains("budget"), "{fed}");
-    let explicit = run(&["--integrator", "symplectic"]);
-    assert!(!explicit.contains("note:"), "{explicit}");
-    let _ = std::fs::remove_dir_all(&dir);
-}

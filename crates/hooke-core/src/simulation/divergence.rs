@@ -41,6 +41,22 @@ pub struct Divergence {
     /// A step size expected to be stable: half the estimate, or half the step in use when
     /// that is smaller (the estimate did not explain the divergence, so take margin).
     pub suggested_dt: f64,
+    /// When the diverging step was a large step (`vbd`, `newton`): how far its steps are
+    /// solved. A step not solved to the end is not backward Euler's, and can gain energy.
+    pub solve: Option<Box<SolveState>>,
+}
+
+/// How far a large step's solve went, for a divergence's advice.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolveState {
+    /// The iteration budget of a step.
+    pub budget: u32,
+    /// Whether the diverging step ended at its budget before its stopping rule.
+    pub capped: bool,
+    /// The stopping tolerance, m/s.
+    pub tolerance: f64,
+    /// The steps so far that ended at their budget (the diverging one included).
+    pub unsolved: u64,
 }
 
 /// Where a step left the state, for [`check`].
@@ -112,6 +128,7 @@ pub(crate) fn check(end: StepEnd<'_>) -> Result<(), Divergence> {
         stable_dt,
         step_stable_dt,
         suggested_dt: suggested(stable_dt, end.dt),
+        solve: None,
     })
 }
 
@@ -218,6 +235,35 @@ impl Divergence {
                 Approx(self.dt),
                 self.stable_dt,
                 self.smaller()
+            )
+        } else if let Some(solve) = &self.solve {
+            let ended = if solve.capped {
+                format!(
+                    "ended at its budget of {} iterations before its tolerance of {} m/s",
+                    solve.budget,
+                    Approx(solve.tolerance)
+                )
+            } else {
+                format!(
+                    "met its stopping rule, which leaves up to {} m/s of a particle's motion \
+                     unsolved",
+                    Approx(solve.tolerance)
+                )
+            };
+            format!(
+                "the {} step {ended} ({} of the {} steps so far ended at their budget; \
+                 docs/physics.md §4.1, \"Stopping rule and accuracy\"): a step not solved to \
+                 the end is not backward Euler's, and can gain energy; solve the steps further \
+                 with a tighter --tolerance and more --iterations{}",
+                self.integrator,
+                solve.unsolved,
+                self.step,
+                if self.integrator == Integrator::Vbd {
+                    ", or take `--integrator newton`, whose line search takes no move that \
+                     raises the step's energy"
+                } else {
+                    ""
+                }
             )
         } else {
             let estimate = if self.stable_dt.is_finite() {

@@ -373,16 +373,32 @@ impl Simulation {
             step: self.step,
             integrator: self.integrator,
             dt: self.dt,
-        })?;
-        self.watch.check(
-            &self.model,
-            &self.particles,
-            &self.initial,
-            self.step,
-            self.time(),
-            self.integrator,
-            self.dt,
-        )
+        })
+        .and_then(|()| {
+            self.watch.check(
+                &self.model,
+                &self.particles,
+                &self.initial,
+                self.step,
+                self.time(),
+                self.integrator,
+                self.dt,
+            )
+        })
+        .map_err(|mut d| {
+            // A large step is stable at any size once solved: what is left unsolved is the
+            // likelier cause.
+            if self.integrator.solves_contacts() {
+                let rule = self.workspace.stop_rule_of(self.integrator);
+                d.solve = Some(Box::new(divergence::SolveState {
+                    budget: u32::try_from(rule.iterations).unwrap_or(u32::MAX),
+                    capped: self.workspace.capped(),
+                    tolerance: rule.tolerance,
+                    unsolved: self.unsolved.steps,
+                }));
+            }
+            d
+        })
     }
 
     /// The crossing watch after a step from `time` (see [`watch`]): a surface found through

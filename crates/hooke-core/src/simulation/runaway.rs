@@ -166,6 +166,7 @@ impl EnergyWatch {
             stable_dt,
             step_stable_dt: stable_dt,
             suggested_dt: super::divergence::suggested(stable_dt, dt),
+            solve: None,
         })
     }
 
