@@ -69,7 +69,7 @@ pub use model::surface::{DEFAULT_CLOTH_THICKNESS, DEFAULT_SURFACE_FRICTION, Surf
 pub use model::{Attachment, ColliderSlot, Model};
 pub use number::{Approx, Num};
 pub use particles::{Particles, SANE_BOUND, Vec3};
-pub use simulation::divergence::{Divergence, SolveState};
+pub use simulation::divergence::Divergence;
 pub use simulation::notice::{Cause, Notice, Through};
 pub use simulation::renumber::Renumbering;
 pub use simulation::stability::StabilityEstimate;
