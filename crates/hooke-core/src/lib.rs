@@ -76,5 +76,4 @@ pub use simulation::stability::StabilityEstimate;
 pub use simulation::start::{PushedOut, StartInside};
 pub use simulation::summary::Summary;
 pub use simulation::swept::MOST_PARTS;
-pub use simulation::unsolved::Unsolved;
 pub use simulation::{RenumberError, Simulation};

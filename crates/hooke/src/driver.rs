@@ -61,25 +61,15 @@ fn tally_notices(scene: &Scene) {
 /// accuracy").
 fn tally_unsolved(scene: &Scene) {
     let sim = &scene.simulation;
+    let (integrator, steps) = (sim.integrator(), sim.steps());
     let unsolved = sim.unsolved();
-    if let Some(said) = unsolved_note(sim.integrator(), unsolved, sim.steps(), sim.workspace()) {
-        reporter().note(&said);
-    }
-}
-
-/// The sentence [`tally_unsolved`] says, when there is anything to say.
-fn unsolved_note(
-    integrator: hooke_core::Integrator,
-    unsolved: hooke_core::Unsolved,
-    steps: u64,
-    workspace: &hooke_core::integrator::Workspace,
-) -> Option<String> {
-    let (first, time) = unsolved.first?;
-    let n = unsolved.steps;
+    let Some(first) = unsolved.first else {
+        return;
+    };
     let what = if integrator == hooke_core::Integrator::Implicit {
         "with its conjugate gradients at their iteration cap, above their tolerance".to_string()
     } else {
-        let rule = workspace.stop_rule_of(integrator);
+        let rule = sim.workspace().stop_rule_of(integrator);
         format!(
             "at its budget of {} iteration{} before its tolerance of {} m/s",
             rule.iterations,
@@ -93,13 +83,15 @@ fn unsolved_note(
     } else {
         ""
     };
-    Some(format!(
-        "{integrator} ended {n} of {steps} step{} {what}, the first at step {first} \
+    reporter().note(&format!(
+        "{integrator} ended {} of {steps} step{} {what}, the first at step {first} \
          (t = {} s): those steps stopped short of their solution (docs/physics.md §4.1, \
          \"Stopping rule and accuracy\"){fix}",
+        unsolved.steps,
         if steps == 1 { "" } else { "s" },
-        hooke_core::Approx(time),
-    ))
+        // A step's end time as `Simulation::time` gives it.
+        hooke_core::Approx(first as f64 * sim.dt()),
+    ));
 }
 
 /// What a notice's surface passed through, as said.

@@ -50,7 +50,7 @@ pub struct Divergence {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolveState {
     /// The iteration budget of a step.
-    pub budget: u32,
+    pub budget: usize,
     /// Whether the diverging step ended at its budget before its stopping rule.
     pub capped: bool,
     /// The stopping tolerance, m/s.

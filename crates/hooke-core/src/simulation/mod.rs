@@ -351,7 +351,7 @@ impl Simulation {
         self.step += 1;
         self.end_pins(time + self.dt);
         if self.workspace.capped() {
-            self.unsolved.record(self.step, self.time());
+            self.unsolved.record(self.step);
         }
         let (moved, crowded) = match phase {
             Ok(moved) => (moved, None),
@@ -391,7 +391,7 @@ impl Simulation {
             if self.integrator.solves_contacts() {
                 let rule = self.workspace.stop_rule_of(self.integrator);
                 d.solve = Some(Box::new(divergence::SolveState {
-                    budget: u32::try_from(rule.iterations).unwrap_or(u32::MAX),
+                    budget: rule.iterations,
                     capped: self.workspace.capped(),
                     tolerance: rule.tolerance,
                     unsolved: self.unsolved.steps,

@@ -9,15 +9,15 @@
 pub struct Unsolved {
     /// How many.
     pub steps: u64,
-    /// The first of them (1 for the first step) and the simulated time at its end, seconds.
-    pub first: Option<(u64, f64)>,
+    /// The first of them (1 for the first step; it ends at `first · dt`).
+    pub first: Option<u64>,
 }
 
 impl Unsolved {
-    /// Counts step `step`, ended at `time`.
-    pub(crate) fn record(&mut self, step: u64, time: f64) {
+    /// Counts step `step`.
+    pub(crate) fn record(&mut self, step: u64) {
         self.steps += 1;
-        self.first.get_or_insert((step, time));
+        self.first.get_or_insert(step);
     }
 }
 
@@ -28,13 +28,13 @@ mod tests {
     #[test]
     fn the_first_is_kept_and_every_one_counted() {
         let mut u = Unsolved::default();
-        u.record(3, 0.05);
-        u.record(7, 0.1);
+        u.record(3);
+        u.record(7);
         assert_eq!(
             u,
             Unsolved {
                 steps: 2,
-                first: Some((3, 0.05))
+                first: Some(3)
             }
         );
     }
